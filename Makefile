@@ -1,0 +1,23 @@
+# Two entry points (see README): `make book` and `make test`. Each installs what it needs.
+PYTHON ?= python3
+PIP := $(PYTHON) -m pip
+
+.PHONY: setup browser-deps test test-lib book bench
+
+setup:
+	$(PIP) install --quiet --disable-pip-version-check -r requirements.txt
+	$(PIP) install --quiet --disable-pip-version-check --no-deps -e .
+	$(PYTHON) -m ipykernel install --user --name python3 >/dev/null
+
+# Debian's Chromium for the browser test (Playwright drives it; no browser download).
+browser-deps:
+	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null)
+
+test: setup browser-deps
+	$(PYTHON) -m pytest
+
+test-lib: setup
+	$(PYTHON) -m pytest tests -m "not browser"
+
+bench: setup
+	$(PYTHON) benchmarks/bench_iteration.py

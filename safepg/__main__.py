@@ -1,0 +1,3 @@
+from safepg.cli import main
+
+raise SystemExit(main())

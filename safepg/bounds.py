@@ -1,0 +1,137 @@
+r"""Concentration bounds on the per-component gradient estimation error (Section 4.3).
+
+Every bound is written as
+
+.. math:: \epsilon(N) = \frac{d_\delta}{\sqrt N} + \frac{f_\delta}{N},
+
+with f = 0 for Chebyshev and Hoeffding (Assumption 4.3.1) and f > 0 for the
+empirical Bernstein bound (Section 4.3.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from safepg.constants import TaskConstants
+
+Bound = Literal["chebyshev", "hoeffding", "bernstein"]
+BOUNDS: tuple[Bound, ...] = ("chebyshev", "hoeffding", "bernstein")
+
+
+def check_delta(delta: float) -> float:
+    """Validate the worsening probability delta in (0, 1)."""
+    if not (isinstance(delta, (int, float, np.floating)) and 0 < delta < 1):
+        raise ValueError(f"delta must be in (0, 1), got {delta!r}")
+    return float(delta)
+
+
+@dataclass(frozen=True)
+class ErrorBound:
+    """epsilon(N) = d / sqrt(N) + f / N."""
+
+    d: float
+    f: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.d) and self.d >= 0):
+            raise ValueError(f"d must be finite and >= 0, got {self.d}")
+        if not (np.isfinite(self.f) and self.f >= 0):
+            raise ValueError(f"f must be finite and >= 0, got {self.f}")
+
+    def eps(self, n: float | np.ndarray) -> float | np.ndarray:
+        """The error bound at batch size ``n``."""
+        n = np.asarray(n, dtype=float)
+        out = self.d / np.sqrt(n) + self.f / n
+        return float(out) if out.ndim == 0 else out
+
+
+def reinforce_variance_factor(k: TaskConstants) -> float:
+    r"""Bound on Var[REINFORCE sample] (Lemma 5.4 of [24], Section 4.3.1).
+
+    .. math:: \frac{R^2 M_\phi^2 H (1-\gamma^H)^2}{\sigma^2 (1-\gamma)^2}
+    """
+    g, H = k.gamma, k.H
+    return (k.R * k.M_phi * (1 - g**H) / (k.sigma * (1 - g))) ** 2 * H
+
+
+def gpomdp_variance_factor(k: TaskConstants) -> float:
+    r"""Bound on Var[G(PO)MDP sample] (Lemma 5.5 of [24], Section 4.3.1).
+
+    .. math:: \frac{R^2 M_\phi^2}{\sigma^2(1-\gamma)^2}\Big[\frac{1-\gamma^{2H}}{1-\gamma^2}
+              + H\gamma^{2H} - 2\gamma^H\frac{1-\gamma^H}{1-\gamma}\Big]
+    """
+    g, H = k.gamma, k.H
+    bracket = (1 - g ** (2 * H)) / (1 - g**2) + H * g ** (2 * H) - 2 * g**H * (1 - g**H) / (1 - g)
+    return (k.R * k.M_phi / (k.sigma * (1 - g))) ** 2 * bracket
+
+
+def chebyshev(delta: float, variance: float) -> ErrorBound:
+    r"""Chebyshev: :math:`d_\delta = \sqrt{\mathrm{Var}[\tilde\nabla_{\theta_i} J]/\delta}` (4.3.1)."""
+    check_delta(delta)
+    return ErrorBound(np.sqrt(variance / delta))
+
+
+def gradient_range_bound(k: TaskConstants) -> float:
+    r"""Lemma 4.3.3: range of a gradient sample, :math:`2 H M_\phi \bar A R / (\sigma^2 (1-\gamma))`."""
+    return 2 * k.H * k.M_phi * k.A_bar * k.R / (k.sigma**2 * (1 - k.gamma))
+
+
+def hoeffding(delta: float, grad_range: float) -> ErrorBound:
+    r"""Hoeffding: :math:`d_\delta = \mathbf R\sqrt{\ln(2/\delta)/2}` (Section 4.3.2)."""
+    check_delta(delta)
+    return ErrorBound(grad_range * np.sqrt(np.log(2 / delta) / 2))
+
+
+def bernstein(delta: float, sample_variance: float, grad_range: float) -> ErrorBound:
+    r"""Empirical Bernstein (Section 4.3.3):
+
+    .. math:: d_\delta = \sqrt{2 S_N \ln(3/\delta)}, \qquad f_\delta = 3\mathbf R\ln(3/\delta)
+    """
+    check_delta(delta)
+    log3 = np.log(3 / delta)
+    return ErrorBound(np.sqrt(2 * sample_variance * log3), 3 * grad_range * log3)
+
+
+def error_bound(
+    bound: Bound,
+    samples: np.ndarray,
+    delta: float,
+    constants: TaskConstants,
+    estimator: str = "gpomdp",
+    empirical_range: bool = False,
+) -> ErrorBound:
+    """The bound of Section 4.3 for one gradient component.
+
+    Parameters
+    ----------
+    bound : {"chebyshev", "hoeffding", "bernstein"}
+    samples : ndarray, shape (N,)
+        Per-trajectory gradient samples of the component being updated (k).
+    delta : float
+        Probability of a worsening update, in (0, 1).
+    constants : TaskConstants
+    estimator : {"reinforce", "gpomdp"}
+        Chooses the Chebyshev variance bound.
+    empirical_range : bool
+        Hoeffding/Bernstein: use max - min of ``samples`` (the thesis's "e.r.")
+        instead of Lemma 4.3.3's range.
+    """
+    check_delta(delta)
+    samples = np.asarray(samples, dtype=float)
+    if samples.ndim != 1 or samples.size < 2:
+        raise ValueError(f"samples must be a 1-D array of at least 2 values, got shape {samples.shape}")
+    if bound == "chebyshev":
+        if estimator == "reinforce":
+            return chebyshev(delta, reinforce_variance_factor(constants))
+        if estimator == "gpomdp":
+            return chebyshev(delta, gpomdp_variance_factor(constants))
+        raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+    if bound not in ("hoeffding", "bernstein"):
+        raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
+    grad_range = float(np.ptp(samples)) if empirical_range else gradient_range_bound(constants)
+    if bound == "hoeffding":
+        return hoeffding(delta, grad_range)
+    return bernstein(delta, float(np.var(samples, ddof=1)), grad_range)

@@ -1,0 +1,88 @@
+"""Command line: ``python -m safepg learn ...`` (and the experiment commands)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+
+from safepg.envs.lqg import LQG
+from safepg.learning import adaptive_pg, vanilla_pg
+
+ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
+
+
+def _learn_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("learn", help="run one learning loop and print a JSON summary")
+    p.add_argument("--env", choices=sorted(ENVS), default="lqg1d")
+    p.add_argument("--estimator", choices=["reinforce", "gpomdp"], default="gpomdp")
+    p.add_argument("--no-baseline", action="store_true", help="use b = 0")
+    p.add_argument("--bound", choices=["chebyshev", "hoeffding", "bernstein"], default="chebyshev")
+    p.add_argument("--empirical-range", action="store_true")
+    p.add_argument("--delta", type=float, default=0.95)
+    p.add_argument("--sigma", type=float, default=1.0)
+    p.add_argument("--theta0", type=float, nargs="+", default=[0.0])
+    p.add_argument("--budget", type=int, default=30_000_000, help="total trajectories")
+    p.add_argument("--n-min", type=int, default=100)
+    p.add_argument("--n-max", type=int, default=500_000)
+    p.add_argument("--fixed-alpha", type=float, help="vanilla PG with this step size")
+    p.add_argument("--fixed-n", type=int, help="vanilla PG with this batch size")
+    p.add_argument("--step", choices=["scalar", "coordinate"], default="scalar",
+                   help="vanilla PG: update all components or only the largest")
+    p.add_argument("--score-action", choices=["clipped", "raw"], default="clipped",
+                   help="score the clipped action (authors' code) or the sampled one (unbiased)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _run_learn(args: argparse.Namespace) -> dict:
+    env = ENVS[args.env]()
+    theta0 = np.asarray(args.theta0, dtype=float)
+    if theta0.size == 1:
+        theta0 = np.full(env.dim**2, theta0[0]) * np.eye(env.dim).ravel() if env.dim > 1 else theta0
+    common = dict(estimator=args.estimator, baseline=not args.no_baseline, bound=args.bound,
+                  delta=args.delta, empirical_range=args.empirical_range, budget=args.budget,
+                  score_action=args.score_action, rng=args.seed, progress=not args.quiet)
+    if args.fixed_alpha is not None or args.fixed_n is not None:
+        if args.fixed_alpha is None or args.fixed_n is None:
+            raise ValueError("--fixed-alpha and --fixed-n must be given together for vanilla PG")
+        rec = vanilla_pg(env, theta0, args.sigma, batch_size=args.fixed_n, alpha=args.fixed_alpha,
+                         step=args.step, **common)
+    else:
+        rec = adaptive_pg(env, theta0, args.sigma, n_min=args.n_min, n_max=args.n_max, **common)
+    out = rec.summary()
+    out["J_star"] = env.performance(env.optimal_gain(), args.sigma)
+    out["theta_star"] = env.optimal_gain().ravel().tolist()
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="safepg", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    _learn_parser(sub)
+    try:
+        from safepg import experiments
+    except ImportError:  # the experiment runner is optional while it is being built
+        experiments = None  # type: ignore[assignment]
+    if experiments is not None:
+        experiments.add_parsers(sub)
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "learn":
+            out = _run_learn(args)
+        else:
+            out = args.func(args)
+    except (ValueError, TypeError) as err:
+        print(f"safepg: error: {err}", file=sys.stderr)
+        return 2
+    if out is not None:
+        json.dump(out, sys.stdout, indent=None if args.command == "learn" else 1)
+        sys.stdout.write("\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,246 @@
+r"""Linear-quadratic Gaussian regulation (LQG), any dimension (thesis Sections 5.1-5.2).
+
+Dynamics, reward and policy (state noise C_0 = 0, as in the thesis):
+
+.. math::
+    s_{t+1} = \operatorname{clip}(A s_t + B u_t), \qquad
+    u_t = \operatorname{clip}(a_t), \quad a_t \sim \mathcal N(K s_t, \Sigma), \qquad
+    r_t = -\tfrac12\,(s_t^\top Q s_t + u_t^\top R u_t)
+
+with states and actions clipped to boxes and the initial state uniform in the state box.
+
+The closed forms (``performance``, ``gradient``, ``optimal_gain``) are for the
+*infinite-horizon, unclipped* problem, which is what the thesis plots as "expected
+performance". They are not the objective the clipped, H-step simulator optimises
+(see SETTINGS.md and the book's "Beyond the thesis" sections).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import solve_discrete_lyapunov
+
+from safepg._rng import RNGLike, as_generator
+from safepg.policies import LinearGaussianPolicy, _check_sigma
+from safepg.trajectories import Trajectories
+
+
+def _as_matrix(x: float | np.ndarray, m: int, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=float)
+    if a.ndim == 0:
+        return np.eye(m) * float(a)
+    if a.shape != (m, m):
+        raise ValueError(f"{name} must be a scalar or a ({m}, {m}) matrix, got shape {a.shape}")
+    return a
+
+
+@dataclass(frozen=True)
+class LQG:
+    """LQG regulation task with box-bounded states and actions.
+
+    Parameters
+    ----------
+    dim : int
+        State and action dimension m.
+    gamma : float
+        Discount factor in (0, 1).
+    horizon : int
+        Trajectory length H used by the simulator.
+    state_bound, action_bound : float
+        Half-widths of the state box [-b_s, b_s]^m and action box [-b_a, b_a]^m.
+    A, B, Q, R : float or ndarray (m, m)
+        Dynamics and cost matrices (a scalar means that multiple of the identity).
+    clip : bool
+        Clip actions and next states to their boxes (the thesis's simulator). With
+        ``clip=False`` the simulator samples the unbounded problem the closed forms
+        describe (used to test them).
+    """
+
+    dim: int = 1
+    gamma: float = 0.9
+    horizon: int = 20
+    state_bound: float = 2.0
+    action_bound: float = 2.0
+    A: np.ndarray | float = 1.0
+    B: np.ndarray | float = 1.0
+    Q: np.ndarray | float = 1.0
+    R: np.ndarray | float = 1.0
+    clip: bool = True
+    _mats: tuple[np.ndarray, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if int(self.dim) != self.dim or self.dim < 1:
+            raise ValueError(f"dim must be a positive integer, got {self.dim}")
+        if not 0 < self.gamma < 1:
+            raise ValueError(f"gamma must be in (0, 1), got {self.gamma}")
+        if int(self.horizon) != self.horizon or self.horizon < 1:
+            raise ValueError(f"horizon must be a positive integer, got {self.horizon}")
+        for name in ("state_bound", "action_bound"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+        mats = tuple(_as_matrix(getattr(self, k), self.dim, k) for k in "ABQR")
+        object.__setattr__(self, "_mats", mats)
+
+    # ------------------------------------------------------------------ settings
+    @classmethod
+    def thesis_1d(cls, **overrides: object) -> LQG:
+        """The one-dimensional task of Section 5.1 with the settings of SETTINGS.md."""
+        return cls(**{"dim": 1, "gamma": 0.9, "horizon": 20, **overrides})  # type: ignore[arg-type]
+
+    @classmethod
+    def thesis_2d(cls, **overrides: object) -> LQG:
+        """The two-dimensional task of Section 5.2.1 as printed (Q = R = I, gamma = 0.95)."""
+        return cls(**{"dim": 2, "gamma": 0.95, "horizon": 20, **overrides})  # type: ignore[arg-type]
+
+    # ------------------------------------------------------------ bound constants
+    @property
+    def reward_bound(self) -> float:
+        """R = max |r| over the boxes: 0.5 (lambda_max(Q) m b_s^2 + lambda_max(R) m b_a^2)."""
+        _, _, Q, R = self._mats
+        q = np.max(np.linalg.eigvalsh(Q)) * self.dim * self.state_bound**2
+        r = np.max(np.linalg.eigvalsh(R)) * self.dim * self.action_bound**2
+        return float(0.5 * (q + r))
+
+    @property
+    def feature_bound(self) -> float:
+        """M_phi: the features are the state, bounded by the state box."""
+        return float(self.state_bound)
+
+    @property
+    def action_volume(self) -> float:
+        """|A|: volume of the action box, (2 b_a)^m."""
+        return float((2 * self.action_bound) ** self.dim)
+
+    # ----------------------------------------------------------------- simulator
+    def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
+        """Simulate ``n`` trajectories of length H at once.
+
+        Random numbers are drawn in a fixed order (initial states, then an (n, H, m)
+        array of standard normals), so a seed fixes the batch bit for bit.
+        """
+        self._check_policy(policy)
+        if int(n) != n or n < 1:
+            raise ValueError(f"n must be a positive integer, got {n}")
+        rng = as_generator(rng)
+        A, B, Q, R = self._mats
+        m, H, bs, ba = self.dim, self.horizon, self.state_bound, self.action_bound
+        s = rng.uniform(-bs, bs, size=(n, m))
+        raw = rng.standard_normal((n, H, m)) @ policy.cov_chol.T
+        feats = np.empty((n, H, m))
+        acts = np.empty((n, H, m))
+        rews = np.empty((n, H))
+        # Time is sequential; each step is one whole-array operation over the n trajectories.
+        for t in range(H):
+            feats[:, t] = s
+            raw[:, t] += s @ policy.gain.T
+            u = np.clip(raw[:, t], -ba, ba) if self.clip else raw[:, t]
+            acts[:, t] = u
+            rews[:, t] = -0.5 * (np.einsum("ni,ij,nj->n", s, Q, s) + np.einsum("ni,ij,nj->n", u, R, u))
+            s = s @ A.T + u @ B.T
+            if self.clip:
+                s = np.clip(s, -bs, bs)
+        return Trajectories(feats, raw, acts, rews, None, self.gamma)
+
+    def _check_policy(self, policy: LinearGaussianPolicy) -> None:
+        if policy.gain.shape != (self.dim, self.dim):
+            raise ValueError(
+                f"theta must be a ({self.dim}, {self.dim}) gain for this LQG, got {policy.gain.shape}"
+            )
+
+    # -------------------------------------------------------------- closed forms
+    def _gain(self, theta: np.ndarray | float) -> np.ndarray:
+        K = np.asarray(theta, dtype=float)
+        if K.size != self.dim**2:
+            raise ValueError(f"theta must have {self.dim ** 2} entries, got {K.size}")
+        if not np.all(np.isfinite(K)):
+            raise ValueError("theta must be finite")
+        return K.reshape(self.dim, self.dim)
+
+    def initial_second_moment(self) -> np.ndarray:
+        """E[s_0 s_0^T] for s_0 uniform in the state box: diag(b_s^2 / 3)."""
+        return np.eye(self.dim) * self.state_bound**2 / 3
+
+    def is_stable(self, theta: np.ndarray | float) -> bool:
+        """Whether sqrt(gamma) (A + B K) is a contraction, so J(theta) is finite."""
+        A, B, _, _ = self._mats
+        F = A + B @ self._gain(theta)
+        return bool(np.max(np.abs(np.linalg.eigvals(F))) * np.sqrt(self.gamma) < 1)
+
+    def value_matrix(self, theta: np.ndarray | float) -> np.ndarray:
+        r"""P solving the discounted Lyapunov equation
+
+        .. math:: P = \tfrac12 (Q + K^\top R K) + \gamma (A + BK)^\top P (A + BK),
+
+        so that V(s) = -s^T P s - v_0 for the unclipped infinite-horizon problem.
+        """
+        A, B, Q, R = self._mats
+        K = self._gain(theta)
+        if not self.is_stable(K):
+            raise ValueError("theta makes the closed loop unstable: J(theta) = -inf")
+        F = A + B @ K
+        P = solve_discrete_lyapunov(np.sqrt(self.gamma) * F.T, 0.5 * (Q + K.T @ R @ K))
+        return 0.5 * (P + P.T)
+
+    def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
+        r"""Closed-form expected performance J(theta) (infinite horizon, no clipping).
+
+        .. math::
+            J(\theta) = -\operatorname{tr}(P\,\mathbb E[s_0 s_0^\top])
+                        - \frac{\tfrac12\operatorname{tr}(R\Sigma)
+                                + \gamma\operatorname{tr}(B^\top P B \Sigma)}{1-\gamma}
+
+        In one dimension this is SETTINGS.md's
+        J = -(b^2/3) P - sigma^2 (0.5 + gamma P) / (1 - gamma),
+        P = 0.5 (1 + theta^2) / (1 - gamma (1 + theta)^2). Returns -inf if unstable.
+        """
+        K = self._gain(theta)
+        if not self.is_stable(K):
+            return -np.inf
+        _, B, _, R = self._mats
+        S = _check_sigma(sigma, self.dim)
+        P = self.value_matrix(K)
+        noise = 0.5 * np.trace(R @ S) + self.gamma * np.trace(B.T @ P @ B @ S)
+        return float(-np.trace(P @ self.initial_second_moment()) - noise / (1 - self.gamma))
+
+    def gradient(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> np.ndarray:
+        r"""Closed-form policy gradient :math:`\nabla_\theta J`, flattened like theta.
+
+        Differentiating the Lyapunov equation gives
+
+        .. math:: \nabla_K J = -\big(R K + 2\gamma B^\top P (A + BK)\big)\, Y,
+                  \qquad Y = W + \gamma (A+BK)\, Y\, (A+BK)^\top,
+
+        with :math:`W = \mathbb E[s_0 s_0^\top] + \gamma B\Sigma B^\top/(1-\gamma)`.
+        """
+        A, B, _, R = self._mats
+        K = self._gain(theta)
+        S = _check_sigma(sigma, self.dim)
+        P = self.value_matrix(K)
+        F = A + B @ K
+        W = self.initial_second_moment() + self.gamma * B @ S @ B.T / (1 - self.gamma)
+        Y = solve_discrete_lyapunov(np.sqrt(self.gamma) * F, W)
+        return (-(R @ K + 2 * self.gamma * B.T @ P @ F) @ Y).ravel()
+
+    def optimal_gain(self, tol: float = 1e-14, max_iter: int = 100_000) -> np.ndarray:
+        r"""Optimal gain K* (the thesis's theta*) by Riccati value iteration.
+
+        .. math::
+            P \leftarrow \tfrac12 Q + \gamma A^\top P A - \gamma^2 A^\top P B
+                         (\tfrac12 R + \gamma B^\top P B)^{-1} B^\top P A, \qquad
+            K^* = -\gamma (\tfrac12 R + \gamma B^\top P B)^{-1} B^\top P A
+
+        The policy noise adds a constant to J, so K* does not depend on Sigma.
+        """
+        A, B, Q, R = self._mats
+        g = self.gamma
+        P = 0.5 * Q
+        for _ in range(max_iter):
+            G = np.linalg.solve(0.5 * R + g * B.T @ P @ B, g * B.T @ P @ A)
+            P_new = 0.5 * Q + g * A.T @ P @ A - g * A.T @ P @ B @ G
+            if np.max(np.abs(P_new - P)) < tol * max(1.0, np.max(np.abs(P))):
+                P = P_new
+                break
+            P = P_new
+        return -np.linalg.solve(0.5 * R + g * B.T @ P @ B, g * B.T @ P @ A)

@@ -1,0 +1,391 @@
+r"""Learning loops of Chapter 5: Algorithm 4.1 (adaptive step and batch size) and
+vanilla policy gradient with a fixed batch size.
+
+Both return a :class:`LearningRecord` of per-iteration arrays. Iteration i collects
+``batch_size[i]`` trajectories with the policy ``theta[i]`` and moves to ``theta[i+1]``.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Literal, Protocol
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from safepg._rng import RNGLike, as_generator
+from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
+from safepg.constants import BoundedTask, TaskConstants
+from safepg.estimators import Estimator, ScoreAction, gradient_samples
+from safepg.meta import coordinate_step, guaranteed_improvement, optimal_batch_size
+from safepg.meta import penalty_constant, scalar_step
+from safepg.policies import LinearGaussianPolicy
+from safepg.trajectories import Trajectories
+
+#: Trajectory counts at which Figures 5.1-5.2 are read off (``LearningRecord.J_at``).
+CHECKPOINTS = (100_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
+
+
+class Task(BoundedTask, Protocol):
+    def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories: ...
+
+
+@dataclass
+class LearningRecord:
+    """Per-iteration record of a learning run (arrays of length I = iterations).
+
+    Attributes
+    ----------
+    batch_size : int array (I,)
+        Trajectories collected at iteration i.
+    alpha : float array (I,)
+        Step size applied (to ``coordinate[i]``, or to every component if -1).
+    coordinate : int array (I,)
+        Updated component k, or -1 for a full (scalar-step) update.
+    theta : float array (I + 1, m)
+        Parameters before each iteration; the last row is the final theta.
+    J : float array (I + 1,)
+        Closed-form expected performance J(theta[i]) (NaN if the task has none).
+    J_hat : float array (I,)
+        Measured performance: mean discounted return of batch i.
+    grad : float array (I, m)
+        Gradient estimate of batch i.
+    eps : float array (I,)
+        Estimation error bound used for the step (0 for a fixed step).
+    safe : bool array (I,)
+        Whether the update came with the high-probability improvement guarantee
+        (Assumption 4.2.7 held: eps < |g_k|).
+    config : dict
+        The settings of the run (JSON-serialisable).
+    interrupted : bool
+        The run was stopped early (KeyboardInterrupt); the arrays hold what was done.
+    """
+
+    batch_size: np.ndarray
+    alpha: np.ndarray
+    coordinate: np.ndarray
+    theta: np.ndarray
+    J: np.ndarray
+    J_hat: np.ndarray
+    grad: np.ndarray
+    eps: np.ndarray
+    safe: np.ndarray
+    config: dict[str, Any] = field(default_factory=dict)
+    interrupted: bool = False
+
+    @property
+    def iterations(self) -> int:
+        return int(self.batch_size.size)
+
+    @property
+    def trajectories(self) -> int:
+        return int(self.batch_size.sum())
+
+    @property
+    def theta_final(self) -> np.ndarray:
+        return self.theta[-1]
+
+    def upsilon_bar(self) -> float:
+        r"""Average performance :math:`\overline\Upsilon` (Tables 5.2-5.4): the measured
+        performance averaged over all trajectories (iterations weighted by batch size)."""
+        return float(self.batch_size @ self.J_hat / self.batch_size.sum())
+
+    def improvement_ratio(self, on: Literal["J", "J_hat"] = "J") -> float:
+        """Share of policy updates after which performance did not decrease.
+
+        ``on="J"``: the closed-form J (Section 5.1); ``on="J_hat"``: the batch-average
+        return of consecutive batches (Section 5.3, no closed form).
+        """
+        perf = self.J if on == "J" else self.J_hat
+        steps = np.diff(perf)
+        if steps.size == 0:
+            return float("nan")
+        return float(np.mean(steps >= 0))
+
+    def J_at(self, checkpoints: tuple[int, ...] = CHECKPOINTS) -> dict[str, float]:
+        """J of the policy that generated trajectory number T (1-based), for each
+        reached checkpoint T: Figures 5.1-5.2 read at T."""
+        ends = np.cumsum(self.batch_size)
+        out = {}
+        for T in checkpoints:
+            if T <= self.trajectories:
+                out[str(T)] = float(self.J[int(np.searchsorted(ends, T))])
+        return out
+
+    def performance_curve(self) -> tuple[np.ndarray, np.ndarray]:
+        """(trajectories used so far, J) as a step curve, Figures 5.1-5.2."""
+        return np.concatenate([[0], np.cumsum(self.batch_size)]), self.J
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary of the run."""
+        return {
+            "iterations": self.iterations,
+            "trajectories": self.trajectories,
+            "theta": self.theta_final.tolist(),
+            "J_initial": float(self.J[0]),
+            "J_final": float(self.J[-1]),
+            "J_at": self.J_at(),
+            "upsilon_bar": self.upsilon_bar(),
+            "improvement_ratio": self.improvement_ratio(),
+            "batch_sizes": self.batch_size.tolist(),
+            "interrupted": self.interrupted,
+        }
+
+    def save(self, path: str | Path) -> None:
+        """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
+        arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
+        meta = json.dumps({"config": self.config, "interrupted": self.interrupted})
+        np.savez_compressed(path, meta=np.array(meta), **arrays)
+
+    @classmethod
+    def load(cls, path: str | Path) -> LearningRecord:
+        with np.load(path) as z:
+            meta = json.loads(str(z["meta"]))
+            arrays = {k: z[k] for k in z.files if k != "meta"}
+        return cls(**arrays, config=meta["config"], interrupted=meta["interrupted"])
+
+
+@dataclass(frozen=True)
+class _Update:
+    delta_theta: np.ndarray
+    alpha: float
+    coordinate: int
+    eps: float
+    safe: bool
+    next_n: int
+
+
+UpdateRule = Callable[[np.ndarray, int], _Update]
+
+
+def _closed_form(task: Task, sigma: float) -> Callable[[np.ndarray], float]:
+    perf = getattr(task, "performance", None)
+    if perf is None:
+        return lambda theta: float("nan")
+    return lambda theta: perf(theta, sigma)
+
+
+def _check_budget(budget: int, n_first: int) -> None:
+    if int(budget) != budget or budget < n_first:
+        raise ValueError(f"budget must be an integer >= the first batch size {n_first}, got {budget}")
+
+
+def _learn(
+    task: Task,
+    policy: LinearGaussianPolicy,
+    rule: UpdateRule,
+    n_first: int,
+    budget: int,
+    rng: RNGLike,
+    estimator: Estimator,
+    baseline: bool,
+    score_action: ScoreAction,
+    config: dict[str, Any],
+    progress: bool,
+) -> LearningRecord:
+    rng = as_generator(rng)
+    J = _closed_form(task, policy.sigma)
+    theta = policy.theta
+    thetas, Js = [theta.copy()], [J(theta)]
+    rows: dict[str, list[Any]] = {k: [] for k in ("batch_size", "alpha", "coordinate", "J_hat", "grad", "eps", "safe")}
+    used, n = 0, n_first
+    interrupted = False
+    bar = tqdm(total=budget, unit="traj", disable=not progress, leave=False, dynamic_ncols=True)
+    try:
+        while True:
+            # The last batch is cut to the remaining budget, so a run uses exactly `budget`.
+            n = min(n, budget - used)
+            if n < 2:
+                break
+            batch = task.simulate(policy, n, rng)
+            samples = gradient_samples(policy, batch, estimator, baseline, score_action)
+            grad = samples.mean(axis=0)
+            if not np.all(np.isfinite(grad)):
+                raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
+            up = rule(samples, n)
+            theta = theta + up.delta_theta
+            policy = policy.with_theta(theta)
+            used += n
+            for k, v in (("batch_size", n), ("alpha", up.alpha), ("coordinate", up.coordinate),
+                         ("J_hat", float(batch.discounted_returns().mean())), ("grad", grad),
+                         ("eps", up.eps), ("safe", up.safe)):
+                rows[k].append(v)
+            thetas.append(theta.copy())
+            Js.append(J(theta))
+            bar.update(n)
+            n = up.next_n
+    except KeyboardInterrupt:
+        interrupted = True
+        warnings.warn(f"interrupted after {used} trajectories; returning the partial record", stacklevel=2)
+    finally:
+        bar.close()
+    m = theta.size
+    return LearningRecord(
+        batch_size=np.asarray(rows["batch_size"], dtype=np.int64),
+        alpha=np.asarray(rows["alpha"], dtype=float),
+        coordinate=np.asarray(rows["coordinate"], dtype=np.int64),
+        theta=np.asarray(thetas, dtype=float).reshape(-1, m),
+        J=np.asarray(Js, dtype=float),
+        J_hat=np.asarray(rows["J_hat"], dtype=float),
+        grad=np.asarray(rows["grad"], dtype=float).reshape(-1, m),
+        eps=np.asarray(rows["eps"], dtype=float),
+        safe=np.asarray(rows["safe"], dtype=bool),
+        config=config,
+        interrupted=interrupted,
+    )
+
+
+def _initial_policy(task: Task, theta0: np.ndarray | float, sigma: float | np.ndarray) -> LinearGaussianPolicy:
+    theta0 = np.asarray(theta0, dtype=float)
+    shape = (getattr(task, "action_dim", None) or getattr(task, "dim", 1), None)
+    d_a = shape[0]
+    if theta0.ndim <= 1:
+        theta0 = np.broadcast_to(theta0, (theta0.size,)) if theta0.ndim == 1 else theta0.reshape(1)
+        m = theta0.size
+        if m % d_a:
+            raise ValueError(f"theta0 must have a multiple of {d_a} entries, got {m}")
+        theta0 = theta0.reshape(d_a, m // d_a)
+    return LinearGaussianPolicy(theta0, sigma)
+
+
+def adaptive_pg(
+    task: Task,
+    theta0: np.ndarray | float = 0.0,
+    sigma: float = 1.0,
+    *,
+    estimator: Estimator = "gpomdp",
+    baseline: bool = True,
+    bound: Bound = "chebyshev",
+    delta: float = 0.95,
+    empirical_range: bool = False,
+    n_min: int = 100,
+    n_max: int = 500_000,
+    budget: int = 30_000_000,
+    score_action: ScoreAction = "clipped",
+    rng: RNGLike = None,
+    progress: bool = False,
+) -> LearningRecord:
+    r"""Adaptive policy gradient, Algorithm 4.1 (as corrected in the book's errata).
+
+    Each iteration collects N trajectories, estimates the gradient, picks
+    :math:`k = \arg\max_i|\hat\nabla_{\theta_i}J|`, computes
+    :math:`\epsilon = d_\delta/\sqrt N + f_\delta/N` from the chosen bound on component k,
+    moves :math:`\theta_k` by the step of Corollary 4.2.8, and sets the next batch size to
+    N* (Theorem 4.3.2, or the search of Section 4.3.3 for Bernstein) clipped to
+    [n_min, n_max]. The first batch has n_min trajectories.
+
+    Parameters
+    ----------
+    task : environment with ``simulate`` and the bound constants (e.g. :class:`~safepg.envs.LQG`)
+    theta0 : initial parameters (flat vector or gain matrix)
+    sigma : policy standard deviation
+    estimator : "reinforce" or "gpomdp"
+    baseline : use the variance-minimising baseline (else b = 0)
+    bound : "chebyshev", "hoeffding" or "bernstein"
+    delta : probability of a worsening update, in (0, 1)
+    empirical_range : Hoeffding/Bernstein with the batch's max - min instead of Lemma 4.3.3
+    n_min, n_max : batch-size limits
+    budget : total number of trajectories
+    score_action : "clipped" (the authors' code) or "raw" (unbiased score)
+    rng : seed or Generator
+    progress : show a tqdm bar
+    """
+    check_delta(delta)
+    if int(n_min) != n_min or n_min < 2:
+        raise ValueError(f"n_min must be an integer >= 2, got {n_min}")
+    if n_min > n_max:
+        raise ValueError(f"n_min must be <= n_max, got n_min={n_min} > n_max={n_max}")
+    _check_budget(budget, n_min)
+    policy = _initial_policy(task, theta0, sigma)
+    constants = TaskConstants.from_task(task, policy.sigma)
+    c = penalty_constant(constants)
+
+    def rule(samples: np.ndarray, n: int) -> _Update:
+        grad = samples.mean(axis=0)
+        k = int(np.argmax(np.abs(grad)))
+        g = float(abs(grad[k]))
+        eb: ErrorBound = error_bound(bound, samples[:, k], delta, constants, estimator, empirical_range)
+        eps = float(eb.eps(n))
+        alpha = coordinate_step(g, eps, c)
+        step = np.zeros_like(grad)
+        step[k] = alpha * grad[k]
+        return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, n_min, n_max))
+
+    config = dict(
+        algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
+        sigma=sigma, estimator=estimator, baseline=baseline, bound=bound, delta=delta,
+        empirical_range=empirical_range, n_min=n_min, n_max=n_max, budget=budget,
+        score_action=score_action, c=c,
+    )
+    return _learn(task, policy, rule, n_min, budget, rng, estimator, baseline, score_action, config, progress)
+
+
+def vanilla_pg(
+    task: Task,
+    theta0: np.ndarray | float = 0.0,
+    sigma: float = 1.0,
+    *,
+    batch_size: int = 100,
+    alpha: float | None = 1e-3,
+    step: Literal["scalar", "coordinate"] = "scalar",
+    estimator: Estimator = "gpomdp",
+    baseline: bool = True,
+    bound: Bound = "chebyshev",
+    delta: float = 0.95,
+    empirical_range: bool = False,
+    budget: int = 1_000_000,
+    score_action: ScoreAction = "clipped",
+    rng: RNGLike = None,
+    progress: bool = False,
+) -> LearningRecord:
+    r"""Policy gradient with a fixed batch size.
+
+    With a fixed ``alpha``: :math:`\theta \leftarrow \theta + \alpha\hat\nabla J` (``step="scalar"``)
+    or only the largest component moves (``step="coordinate"``). With ``alpha=None`` the
+    step is adaptive, using the bound's eps at the fixed N: the scalar step of [24]
+    (``"scalar"``) or the coordinate step Lambda* of Corollary 4.2.8 (``"coordinate"``),
+    as compared in Section 5.2.1 (Figures 5.5-5.6).
+    """
+    if int(batch_size) != batch_size or batch_size < 2:
+        raise ValueError(f"batch_size must be an integer >= 2, got {batch_size}")
+    if alpha is not None and not (np.isfinite(alpha) and alpha >= 0):
+        raise ValueError(f"alpha must be finite and >= 0, got {alpha}")
+    if step not in ("scalar", "coordinate"):
+        raise ValueError(f"step must be 'scalar' or 'coordinate', got {step!r}")
+    if alpha is None:
+        check_delta(delta)
+    _check_budget(budget, batch_size)
+    policy = _initial_policy(task, theta0, sigma)
+    constants = TaskConstants.from_task(task, policy.sigma)
+    c = penalty_constant(constants)
+
+    def rule(samples: np.ndarray, n: int) -> _Update:
+        grad = samples.mean(axis=0)
+        k = int(np.argmax(np.abs(grad)))
+        eps, safe, a = 0.0, True, alpha
+        if alpha is None:
+            # One common eps for all components: the largest per-component bound.
+            eps = max(float(error_bound(bound, samples[:, i], delta, constants, estimator,
+                                        empirical_range).eps(n)) for i in range(grad.size))
+            safe = eps < abs(grad[k])
+            a = scalar_step(grad, eps, c) if step == "scalar" else coordinate_step(abs(grad[k]), eps, c)
+        assert a is not None
+        if step == "scalar":
+            return _Update(a * grad, a, -1, eps, safe, batch_size)
+        d = np.zeros_like(grad)
+        d[k] = a * grad[k]
+        return _Update(d, a, k, eps, safe, batch_size)
+
+    config = dict(
+        algorithm="vanilla", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
+        sigma=sigma, batch_size=batch_size, alpha=alpha, step=step, estimator=estimator,
+        baseline=baseline, bound=bound, delta=delta, empirical_range=empirical_range,
+        budget=budget, score_action=score_action, c=c,
+    )
+    return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress)
+
+
+__all__ = ["LearningRecord", "adaptive_pg", "vanilla_pg", "guaranteed_improvement", "CHECKPOINTS"]

@@ -1,0 +1,156 @@
+"""Learning loops: determinism, record invariants, metrics, bad input."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from safepg.cli import main
+from safepg.envs.lqg import LQG
+from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.meta import coordinate_step, penalty_constant
+from safepg.constants import TaskConstants
+
+ENV = LQG.thesis_1d()
+ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe")
+
+
+def _equal(a: LearningRecord, b: LearningRecord) -> bool:
+    return all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ARRAYS)
+
+
+@pytest.mark.parametrize("bound,er", [("chebyshev", False), ("hoeffding", True), ("bernstein", True)])
+def test_same_seed_same_record(bound, er):
+    kw = dict(bound=bound, empirical_range=er, budget=20_000)
+    a, b = adaptive_pg(ENV, rng=5, **kw), adaptive_pg(ENV, rng=5, **kw)
+    assert _equal(a, b)
+    assert not _equal(a, adaptive_pg(ENV, rng=6, **kw))
+
+
+def test_adaptive_record_invariants():
+    rec = adaptive_pg(ENV, 0.0, 1.0, bound="bernstein", empirical_range=True, budget=50_000, rng=1)
+    I = rec.iterations
+    assert rec.trajectories == 50_000 and rec.batch_size[0] == 100
+    assert rec.theta.shape == (I + 1, 1) and rec.J.shape == (I + 1,)
+    assert np.all(rec.batch_size[:-1] >= 100) and np.all(rec.batch_size <= 500_000)
+    np.testing.assert_allclose(rec.J, [ENV.performance(t, 1.0) for t in rec.theta])
+    # theta moves by alpha * g_k on the chosen coordinate, with Corollary 4.2.8's alpha.
+    np.testing.assert_allclose(np.diff(rec.theta[:, 0]), rec.alpha * rec.grad[:, 0])
+    c = penalty_constant(TaskConstants.from_task(ENV, 1.0))
+    np.testing.assert_allclose(rec.alpha, [coordinate_step(abs(g), e, c) for g, e in zip(rec.grad[:, 0], rec.eps)])
+    assert np.array_equal(rec.safe, rec.eps < np.abs(rec.grad[:, 0]))
+    assert rec.improvement_ratio() == 1.0 and rec.J[-1] > rec.J[0]
+
+
+def test_two_dimensional_coordinate_descent_moves_one_entry():
+    env = LQG.thesis_2d()
+    rec = adaptive_pg(env, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=20_000, rng=0)
+    moved = np.count_nonzero(np.diff(rec.theta, axis=0), axis=1)
+    assert np.all(moved <= 1)
+    assert set(rec.coordinate.tolist()) <= {0, 3}  # the diagonal gains dominate from theta = 0
+
+
+def test_metrics():
+    rec = adaptive_pg(ENV, 0.0, 1.0, bound="bernstein", empirical_range=True, budget=30_000, rng=2)
+    assert rec.upsilon_bar() == pytest.approx(np.sum(rec.batch_size * rec.J_hat) / rec.batch_size.sum())
+    J = np.array([-3.0, -2.0, -2.5, -2.5, -1.0])
+    fake = LearningRecord(np.array([10, 20, 30, 40]), *(np.zeros(4),) * 2, np.zeros((5, 1)), J,
+                          np.zeros(4), np.zeros((4, 1)), np.zeros(4), np.ones(4, bool))
+    assert fake.improvement_ratio() == 0.75
+    ends = {"10": J[0], "11": J[1], "30": J[1], "31": J[2], "100": J[3]}
+    assert fake.J_at(tuple(int(k) for k in ends)) == ends
+
+
+def test_vanilla_fixed_step():
+    rec = vanilla_pg(ENV, -0.55, 0.5, batch_size=100, alpha=1e-4, budget=5_000, rng=3)
+    assert rec.iterations == 50 and np.all(rec.batch_size == 100)
+    np.testing.assert_allclose(np.diff(rec.theta[:, 0]), 1e-4 * rec.grad[:, 0])
+
+
+def test_vanilla_adaptive_steps_in_two_dimensions():
+    env = LQG.thesis_2d()
+    kw = dict(batch_size=2000, alpha=None, bound="chebyshev", delta=0.95, budget=20_000, rng=4)
+    scal = vanilla_pg(env, np.zeros(4), 1.0, step="scalar", **kw)
+    coord = vanilla_pg(env, np.zeros(4), 1.0, step="coordinate", **kw)
+    assert np.all(np.count_nonzero(np.diff(coord.theta, axis=0), axis=1) <= 1)
+    assert np.all(scal.coordinate == -1)
+    # Same seed, same first batch: Corollary 4.2.5's ordering of the two steps.
+    np.testing.assert_array_equal(scal.grad[0], coord.grad[0])
+    assert coord.alpha[0] > scal.alpha[0] > 0
+    assert coord.J[-1] > coord.J[0] and scal.J[-1] > scal.J[0]
+
+
+def test_save_load_roundtrip(tmp_path):
+    rec = adaptive_pg(ENV, budget=5_000, rng=1)
+    rec.save(tmp_path / "r.npz")
+    back = LearningRecord.load(tmp_path / "r.npz")
+    assert _equal(rec, back) and back.config == json.loads(json.dumps(rec.config))
+
+
+def test_interrupt_keeps_what_was_computed():
+    calls = {"n": 0}
+
+    class Flaky(LQG):
+        def simulate(self, policy, n, rng=None):
+            calls["n"] += 1
+            if calls["n"] == 4:
+                raise KeyboardInterrupt
+            return super().simulate(policy, n, rng)
+
+    with pytest.warns(UserWarning, match="interrupted"):
+        rec = adaptive_pg(Flaky(), budget=100_000, rng=0)
+    assert rec.interrupted and rec.iterations == 3 and rec.theta.shape == (4, 1)
+
+
+@pytest.mark.parametrize(
+    "kwargs,name",
+    [({"delta": 1.2}, "delta"), ({"delta": 0.0}, "delta"), ({"sigma": 0.0}, "sigma"),
+     ({"sigma": -1.0}, "sigma"), ({"n_min": 600_000}, "n_min"), ({"budget": 50}, "budget"),
+     ({"theta0": np.nan}, "theta"), ({"theta0": [0.0, 0.0]}, "theta")],
+)
+def test_bad_input_names_the_parameter(kwargs, name):
+    with pytest.raises(ValueError, match=f"^{name}"):
+        adaptive_pg(ENV, **{"budget": 1000, **kwargs})
+
+
+def test_nan_gradient_raises():
+    class Broken(LQG):
+        def simulate(self, policy, n, rng=None):
+            b = super().simulate(policy, n, rng)
+            b.rewards[0, 0] = np.nan
+            return b
+
+    with pytest.raises(ValueError, match="^gradient estimate is not finite"):
+        adaptive_pg(Broken(), budget=1000, rng=0)
+
+
+def test_cli_learn_json(capsys):
+    assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--empirical-range",
+                 "--quiet", "--seed", "3"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("iterations", "trajectories", "theta", "J_initial", "J_star", "J_final", "J_at",
+                "upsilon_bar", "improvement_ratio", "batch_sizes"):
+        assert key in out
+    assert out["trajectories"] == 120_000 and list(out["J_at"]) == ["100000"]
+    assert out["J_initial"] == pytest.approx(-56.667, abs=1e-3)
+    assert out["J_star"] == pytest.approx(-13.207, abs=1e-3)
+    assert len(out["batch_sizes"]) == out["iterations"]
+
+
+def test_cli_vanilla(capsys):
+    assert main(["learn", "--fixed-alpha", "1e-4", "--fixed-n", "100", "--budget", "2000",
+                 "--theta0", "-0.55", "--sigma", "0.5", "--quiet"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["batch_sizes"] == [100] * 20
+
+
+@pytest.mark.parametrize("args,word", [(["--delta", "1.5"], "delta"), (["--sigma", "0"], "sigma"),
+                                       (["--n-min", "10", "--n-max", "5"], "n_min")])
+def test_cli_bad_input_one_line_no_traceback(args, word):
+    p = subprocess.run([sys.executable, "-m", "safepg", "learn", "--quiet", "--budget", "1000", *args],
+                       capture_output=True, text=True)
+    assert p.returncode != 0
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0] and "Traceback" not in p.stderr
