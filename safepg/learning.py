@@ -168,6 +168,22 @@ def _closed_form(task: Task, sigma: float) -> Callable[[np.ndarray], float]:
     return lambda theta: perf(theta, sigma)
 
 
+def _collect(
+    task: Task, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator,
+    estimator: Estimator, baseline: bool, score_action: ScoreAction,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gradient samples (n, m) and discounted returns (n,) of a fresh batch.
+
+    Uses the task's fused ``gradient_batch`` when it has one (the LQG does), else
+    simulates the batch and applies :func:`safepg.estimators.gradient_samples`.
+    """
+    fused = getattr(task, "gradient_batch", None)
+    if fused is not None:
+        return fused(policy, n, rng, estimator, baseline, score_action)
+    batch = task.simulate(policy, n, rng)
+    return gradient_samples(policy, batch, estimator, baseline, score_action), batch.discounted_returns()
+
+
 def _check_budget(budget: int, n_first: int) -> None:
     if int(budget) != budget or budget < n_first:
         raise ValueError(f"budget must be an integer >= the first batch size {n_first}, got {budget}")
@@ -200,8 +216,7 @@ def _learn(
             n = min(n, budget - used)
             if n < 2:
                 break
-            batch = task.simulate(policy, n, rng)
-            samples = gradient_samples(policy, batch, estimator, baseline, score_action)
+            samples, returns = _collect(task, policy, n, rng, estimator, baseline, score_action)
             grad = samples.mean(axis=0)
             if not np.all(np.isfinite(grad)):
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
@@ -210,7 +225,7 @@ def _learn(
             policy = policy.with_theta(theta)
             used += n
             for k, v in (("batch_size", n), ("alpha", up.alpha), ("coordinate", up.coordinate),
-                         ("J_hat", float(batch.discounted_returns().mean())), ("grad", grad),
+                         ("J_hat", float(returns.mean())), ("grad", grad),
                          ("eps", up.eps), ("safe", up.safe)):
                 rows[k].append(v)
             thetas.append(theta.copy())

@@ -244,3 +244,41 @@ class LQG:
                 break
             P = P_new
         return -np.linalg.solve(0.5 * R + g * B.T @ P @ B, g * B.T @ P @ A)
+
+    # ------------------------------------------------------------------ fast path
+    def gradient_batch(
+        self,
+        policy: LinearGaussianPolicy,
+        n: int,
+        rng: RNGLike = None,
+        estimator: str = "gpomdp",
+        baseline: bool = True,
+        score_action: str = "clipped",
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Gradient samples (n, m) and discounted returns (n,) of a fresh batch, fused.
+
+        Same random numbers, in the same order, as :meth:`simulate`, and the same numbers
+        as ``gradient_samples(policy, simulate(...), ...)`` up to rounding, without
+        materialising the trajectories (see :mod:`safepg.envs._lqg_kernel`).
+        """
+        from safepg.envs._lqg_kernel import lqg1d_gradient_samples, lqg_gradient_samples
+
+        self._check_policy(policy)
+        if int(n) != n or n < 1:
+            raise ValueError(f"n must be a positive integer, got {n}")
+        if estimator not in ("reinforce", "gpomdp"):
+            raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+        if score_action not in ("clipped", "raw"):
+            raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+        rng = as_generator(rng)
+        A, B, Q, R = self._mats
+        s0 = rng.uniform(-self.state_bound, self.state_bound, size=(n, self.dim))
+        z = rng.standard_normal((n, self.horizon, self.dim))
+        flags = (float(self.gamma), float(self.state_bound), float(self.action_bound), bool(self.clip),
+                 score_action == "clipped", estimator == "reinforce", bool(baseline))
+        if self.dim == 1:
+            return lqg1d_gradient_samples(
+                float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
+                float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), s0, z, *flags)
+        return lqg_gradient_samples(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R,
+                                    s0, z, *flags)
