@@ -82,7 +82,13 @@ class LinearGaussianPolicy:
         theta = np.asarray(theta, dtype=float)
         if theta.size != self.gain.size:
             raise ValueError(f"theta must have {self.gain.size} entries, got {theta.size}")
-        return LinearGaussianPolicy(theta.reshape(self.gain.shape), self.cov)
+        if not np.all(np.isfinite(theta)):
+            raise ValueError("theta must be finite (got NaN or inf)")
+        # Same covariance: reuse its factorisations instead of validating it again.
+        new = object.__new__(LinearGaussianPolicy)
+        new.gain = theta.reshape(self.gain.shape).copy()
+        new.cov, new.cov_chol, new.precision = self.cov, self.cov_chol, self.precision
+        return new
 
     def mean(self, features: np.ndarray) -> np.ndarray:
         """K phi(s) for features of shape (..., d_phi) -> (..., d_a)."""

@@ -166,7 +166,8 @@ class LQG:
         """Whether sqrt(gamma) (A + B K) is a contraction, so J(theta) is finite."""
         A, B, _, _ = self._mats
         F = A + B @ self._gain(theta)
-        return bool(np.max(np.abs(np.linalg.eigvals(F))) * np.sqrt(self.gamma) < 1)
+        radius = abs(F[0, 0]) if self.dim == 1 else np.max(np.abs(np.linalg.eigvals(F)))
+        return bool(radius * np.sqrt(self.gamma) < 1)
 
     def value_matrix(self, theta: np.ndarray | float) -> np.ndarray:
         r"""P solving the discounted Lyapunov equation
@@ -180,7 +181,10 @@ class LQG:
         if not self.is_stable(K):
             raise ValueError("theta makes the closed loop unstable: J(theta) = -inf")
         F = A + B @ K
-        P = solve_discrete_lyapunov(np.sqrt(self.gamma) * F.T, 0.5 * (Q + K.T @ R @ K))
+        M = 0.5 * (Q + K.T @ R @ K)
+        if self.dim == 1:  # the learning loop evaluates J every iteration: skip the solver
+            return M / (1 - self.gamma * F * F)
+        P = solve_discrete_lyapunov(np.sqrt(self.gamma) * F.T, M)
         return 0.5 * (P + P.T)
 
     def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
