@@ -93,11 +93,11 @@ def test_interrupt_keeps_what_was_computed():
     calls = {"n": 0}
 
     class Flaky(LQG):
-        def simulate(self, policy, n, rng=None):
+        def gradient_batch(self, *args):
             calls["n"] += 1
             if calls["n"] == 4:
                 raise KeyboardInterrupt
-            return super().simulate(policy, n, rng)
+            return super().gradient_batch(*args)
 
     with pytest.warns(UserWarning, match="interrupted"):
         rec = adaptive_pg(Flaky(), budget=100_000, rng=0)
@@ -117,10 +117,10 @@ def test_bad_input_names_the_parameter(kwargs, name):
 
 def test_nan_gradient_raises():
     class Broken(LQG):
-        def simulate(self, policy, n, rng=None):
-            b = super().simulate(policy, n, rng)
-            b.rewards[0, 0] = np.nan
-            return b
+        def gradient_batch(self, *args):
+            samples, returns = super().gradient_batch(*args)
+            samples[0, 0] = np.nan
+            return samples, returns
 
     with pytest.raises(ValueError, match="^gradient estimate is not finite"):
         adaptive_pg(Broken(), budget=1000, rng=0)
