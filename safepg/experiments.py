@@ -1,0 +1,354 @@
+r"""The experiments of Chapter 5, defined once as data, run in parallel, stored on disk.
+
+An :class:`Experiment` is a named list of :class:`RunConfig` (one row of a table or one
+curve of a figure) run for several seeds. :func:`run_experiment` executes the missing
+runs through joblib (all cores by default; a user with a cluster can wrap the call in
+``joblib.parallel_config(backend="dask")`` or ``"ray"`` without code changes), shows
+tqdm progress, and writes each finished run atomically to
+``<results>/<experiment>/<config>/seed-<k>.npz`` with its config and the library
+version as metadata. An interrupted campaign resumes where it stopped; a run whose
+config or library version changed is recomputed, the others are not.
+
+The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import tempfile
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from scipy import stats
+from tqdm.auto import tqdm
+
+from safepg.learning import CHECKPOINTS, LearningRecord, adaptive_pg, vanilla_pg
+
+#: Bump when a change to the library alters the numbers a run produces; stored runs with
+#: another version are recomputed.
+RESULTS_VERSION = "1"
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """One learning configuration (the keyword arguments of a learning loop)."""
+
+    name: str
+    algorithm: Literal["adaptive", "vanilla"] = "adaptive"
+    env: str = "lqg1d"
+    theta0: tuple[float, ...] = (0.0,)
+    sigma: float = 1.0
+    estimator: Literal["reinforce", "gpomdp"] = "gpomdp"
+    baseline: bool = True
+    bound: Literal["chebyshev", "hoeffding", "bernstein"] = "chebyshev"
+    delta: float = 0.95
+    empirical_range: bool = False
+    n_min: int = 100
+    n_max: int = 500_000
+    batch_size: int | None = None
+    alpha: float | None = None
+    step: Literal["scalar", "coordinate"] = "scalar"
+    budget: int = 30_000_000
+    score_action: Literal["clipped", "raw"] = "clipped"
+
+    def key(self) -> str:
+        """Hash of everything that determines a run's numbers (not its name)."""
+        d = asdict(self)
+        d.pop("name")
+        blob = json.dumps([d, RESULTS_VERSION], sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def seed(self, k: int) -> np.random.SeedSequence:
+        """Independent stream for seed index k of this configuration."""
+        return np.random.SeedSequence([k, int(self.key(), 16) % 2**63])
+
+    def run(self, k: int, progress: bool = False) -> LearningRecord:
+        """Run seed k."""
+        env = make_env(self.env)
+        common = dict(estimator=self.estimator, baseline=self.baseline, bound=self.bound,
+                      delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
+                      score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
+                      progress=progress)
+        theta0 = np.asarray(self.theta0, dtype=float)
+        if self.algorithm == "adaptive":
+            return adaptive_pg(env, theta0, self.sigma, n_min=self.n_min, n_max=self.n_max, **common)
+        if self.batch_size is None:
+            raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
+        return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
+                          step=self.step, **common)
+
+
+def make_env(name: str) -> Any:
+    """Environment by name: ``lqg1d``, ``lqg2d``."""
+    from safepg.envs.lqg import LQG
+
+    envs = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
+    if name not in envs:
+        raise ValueError(f"env must be one of {sorted(envs)}, got {name!r}")
+    return envs[name]()
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A named set of configurations run for ``seeds`` seeds each.
+
+    ``thesis`` maps a config name to the values the thesis prints for it.
+    """
+
+    name: str
+    description: str
+    configs: tuple[RunConfig, ...]
+    seeds: int = 5
+    thesis: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def config(self, name: str) -> RunConfig:
+        for c in self.configs:
+            if c.name == name:
+                return c
+        raise KeyError(f"{self.name} has no config {name!r}")
+
+
+# ------------------------------------------------------------------ Section 5.1
+_T51_ALPHAS = (1e-3, 1e-4, 1e-5, 1e-6)
+_T51_NS = (10_000, 1_000, 100)
+#: Table 5.1 as printed: improvement ratio (%) by sigma, N, alpha.
+_T51_PRINTED = {
+    0.5: {10_000: (95.96, 100, 98.99, 100), 1_000: (52.85, 73.27, 81.88, 83.88), 100: (49.79, 51.41, 55.69, 58.44)},
+    1.0: {10_000: (24.24, 100, 100, 100), 1_000: (37.4, 27.03, 99.9, 100), 100: (50.4, 46.08, 39.04, 86.04)},
+}
+
+
+def _table_5_1() -> Experiment:
+    configs, thesis = [], {}
+    for sigma in (0.5, 1.0):
+        for n in _T51_NS:
+            for alpha, printed in zip(_T51_ALPHAS, _T51_PRINTED[sigma][n]):
+                name = f"sigma={sigma}-N={n}-alpha={alpha:.0e}"
+                configs.append(RunConfig(name, "vanilla", theta0=(-0.55,), sigma=sigma, batch_size=n,
+                                         alpha=alpha, budget=1_000_000))
+                thesis[name] = {"improvement_ratio": round(printed / 100, 6)}
+    return Experiment("table-5.1", "Improvement ratio of vanilla G(PO)MDP with fixed step and batch "
+                      "size, theta_0 = -0.55, 10^6 trajectories (Table 5.1).", tuple(configs), 5, thesis)
+
+
+#: Table 5.2 as printed: (estimator, bound, empirical range, delta, Upsilon-bar, CI).
+_T52_PRINTED = [
+    ("reinforce", "chebyshev", False, 0.95, -11.3266, (-11.3277, -11.3256)),
+    ("reinforce", "chebyshev", False, 0.75, -11.4303, (-11.4308, -11.4297)),
+    ("reinforce", "chebyshev", False, 0.5, -11.5947, (-11.5958, -11.5937)),
+    ("gpomdp", "chebyshev", False, 0.95, -10.6085, (-10.6087, -10.6083)),
+    ("gpomdp", "chebyshev", False, 0.75, -10.7141, (-10.7145, -10.7136)),
+    ("gpomdp", "chebyshev", False, 0.5, -10.9036, (-10.9040, -10.9031)),
+    ("gpomdp", "chebyshev", False, 0.25, -11.2355, (-11.2363, -11.2346)),
+    ("gpomdp", "chebyshev", False, 0.05, -11.836, (-11.8368, -11.8352)),
+    ("gpomdp", "hoeffding", False, 0.95, -11.914, (-11.9143, -11.9136)),
+    ("gpomdp", "bernstein", False, 0.95, -10.2159, (-10.2162, -10.2155)),
+    ("gpomdp", "hoeffding", True, 0.95, -9.8582, (-9.8589, -9.8574)),
+    # Printed as [-9.6619; -9.6627]: the interval's ends are swapped in the thesis.
+    ("gpomdp", "bernstein", True, 0.95, -9.6623, (-9.6627, -9.6619)),
+]
+
+
+def t52_name(estimator: str, bound: str, empirical_range: bool, delta: float) -> str:
+    return f"{estimator}-{bound}{'-er' if empirical_range else ''}-delta={delta}"
+
+
+def _table_5_2() -> Experiment:
+    configs, thesis = [], {}
+    for est, bound, er, delta, ups, ci in _T52_PRINTED:
+        name = t52_name(est, bound, er, delta)
+        configs.append(RunConfig(name, estimator=est, bound=bound, empirical_range=er, delta=delta))  # type: ignore[arg-type]
+        thesis[name] = {"upsilon_bar": ups, "ci95": list(ci)}
+    return Experiment("table-5.2", "Adaptive batch size on the 1-D LQG: the twelve estimator x bound x "
+                      "delta rows of Table 5.2 (theta_0 = 0, sigma = 1, 3*10^7 trajectories), "
+                      "also Figures 5.1-5.4.", tuple(configs), 5, thesis)
+
+
+EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (_table_5_1(), _table_5_2())}
+
+
+def get_experiment(name: str) -> Experiment:
+    if name not in EXPERIMENTS:
+        raise ValueError(f"experiment must be one of {sorted(EXPERIMENTS)}, got {name!r}")
+    return EXPERIMENTS[name]
+
+
+def scaled(exp: Experiment, seeds: int | None = None, budget: int | None = None) -> Experiment:
+    """The same experiment with fewer seeds or another trajectory budget."""
+    configs = exp.configs if budget is None else tuple(replace(c, budget=budget) for c in exp.configs)
+    return replace(exp, configs=configs, seeds=exp.seeds if seeds is None else seeds)
+
+
+# ------------------------------------------------------------------ storage
+def results_dir() -> Path:
+    return Path(os.environ.get("SAFEPG_RESULTS", "results"))
+
+
+def run_path(exp: Experiment, cfg: RunConfig, k: int, root: Path | None = None) -> Path:
+    return (root or results_dir()) / exp.name / cfg.name / f"seed-{k}.npz"
+
+
+def _stored(path: Path, cfg: RunConfig) -> LearningRecord | None:
+    """The stored run at ``path`` if it is finished and was made by this config."""
+    if not path.exists():
+        return None
+    try:
+        rec = LearningRecord.load(path)
+    except (OSError, ValueError, KeyError):
+        return None
+    if rec.interrupted or rec.config.get("run_key") != cfg.key():
+        return None
+    return rec
+
+
+def _save_atomic(rec: LearningRecord, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
+    os.close(fd)
+    try:
+        rec.save(tmp)
+        os.replace(tmp, path)  # readers see the old file or the whole new one, never half
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def _run_and_store(cfg: RunConfig, k: int, path: Path, single_thread: bool) -> str:
+    if single_thread:  # joblib already uses every core; numba threads would oversubscribe
+        import numba
+
+        numba.set_num_threads(1)
+    rec = cfg.run(k)
+    rec.config["run_key"] = cfg.key()
+    rec.config["config_name"] = cfg.name
+    _save_atomic(rec, path)
+    return str(path)
+
+
+def run_experiment(
+    exp: Experiment | str,
+    seeds: int | None = None,
+    budget: int | None = None,
+    jobs: int = -1,
+    root: Path | None = None,
+    progress: bool = True,
+) -> dict[str, list[LearningRecord]]:
+    """Run every missing (config, seed) of ``exp`` and return all records by config name.
+
+    Finished runs are loaded, never recomputed; each new run is saved as soon as it
+    finishes, so an interrupted campaign loses nothing already computed.
+    """
+    from joblib import Parallel, delayed, effective_n_jobs
+
+    exp = get_experiment(exp) if isinstance(exp, str) else exp
+    exp = scaled(exp, seeds, budget)
+    todo = [(c, k) for c in exp.configs for k in range(exp.seeds)
+            if _stored(run_path(exp, c, k, root), c) is None]
+    if todo:
+        n_jobs = effective_n_jobs(jobs)
+        tasks = (delayed(_run_and_store)(c, k, run_path(exp, c, k, root), n_jobs > 1) for c, k in todo)
+        # Longest runs first keeps both cores busy to the end.
+        with tqdm(total=len(todo), desc=exp.name, unit="run", disable=not progress) as bar:
+            for _ in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+                bar.update()
+    return load_experiment(exp, root)
+
+
+def load_experiment(exp: Experiment | str, root: Path | None = None) -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``exp`` by config name (missing seeds are left out)."""
+    exp = get_experiment(exp) if isinstance(exp, str) else exp
+    out: dict[str, list[LearningRecord]] = {}
+    for c in exp.configs:
+        recs = [_stored(run_path(exp, c, k, root), c) for k in range(exp.seeds)]
+        out[c.name] = [r for r in recs if r is not None]
+    return out
+
+
+# ------------------------------------------------------------------ report
+def mean_ci95(values: Iterable[float]) -> dict[str, Any]:
+    """Mean and 95% Student-t confidence interval over seeds."""
+    x = np.asarray(list(values), dtype=float)
+    if x.size == 0:
+        return {"mean": None, "ci95": [None, None]}
+    m = float(x.mean())
+    if x.size < 2:
+        return {"mean": m, "ci95": [m, m]}
+    h = float(stats.t.ppf(0.975, x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
+    return {"mean": m, "ci95": [m - h, m + h]}
+
+
+def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,
+           root: Path | None = None) -> dict[str, Any]:
+    """One JSON-ready object per configuration, with the thesis's printed values beside ours."""
+    exp = get_experiment(exp) if isinstance(exp, str) else exp
+    records = load_experiment(exp, root) if records is None else records
+    rows = []
+    for c in exp.configs:
+        recs = records.get(c.name, [])
+        j_at: dict[str, float] = {}
+        for T in CHECKPOINTS:
+            vals = [r.J_at((T,)).get(str(T)) for r in recs]
+            if vals and all(v is not None for v in vals):
+                j_at[str(T)] = float(np.mean(vals))
+        rows.append({
+            "name": c.name, "estimator": c.estimator, "bound": c.bound,
+            "empirical_range": c.empirical_range, "delta": c.delta, "sigma": c.sigma,
+            "algorithm": c.algorithm, "budget": c.budget,
+            "batch_size": c.batch_size, "alpha": c.alpha,
+            "seeds": len(recs),
+            "upsilon_bar": mean_ci95(r.upsilon_bar() for r in recs),
+            "improvement_ratio": mean_ci95(r.improvement_ratio() for r in recs),
+            "J_at": j_at,
+            "J_final": float(np.mean([r.J[-1] for r in recs])) if recs else None,
+            "iterations": float(np.mean([r.iterations for r in recs])) if recs else None,
+            "thesis": exp.thesis.get(c.name),
+        })
+    return {"experiment": exp.name, "configs": rows}
+
+
+# ------------------------------------------------------------------ command line
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("list", help="name every experiment")
+    p.set_defaults(func=_cmd_list)
+    p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")
+    p.add_argument("name")
+    p.add_argument("--seeds", type=int, help="number of seeds (default: the thesis's)")
+    p.add_argument("--budget", type=int, help="trajectories per run (default: the thesis's)")
+    p.add_argument("--jobs", type=int, default=-1, help="parallel jobs (default: all cores)")
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=_cmd_run)
+    p = sub.add_parser("report", help="summarise an experiment's stored runs")
+    p.add_argument("name")
+    p.add_argument("--seeds", type=int)
+    p.add_argument("--budget", type=int)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_cmd_report)
+
+
+def _cmd_list(args: argparse.Namespace) -> None:
+    for e in EXPERIMENTS.values():
+        print(f"{e.name:12s} {len(e.configs):3d} configs x {e.seeds} seeds  {e.description}")
+    return None
+
+
+def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
+    exp = scaled(get_experiment(args.name), args.seeds, args.budget)
+    recs = run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
+    return report(exp, recs)
+
+
+def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
+    exp = scaled(get_experiment(args.name), args.seeds, args.budget)
+    out = report(exp)
+    if args.json:
+        return out
+    for row in out["configs"]:
+        ups, ir = row["upsilon_bar"]["mean"], row["improvement_ratio"]["mean"]
+        print(f"{row['name']:40s} seeds={row['seeds']}  upsilon_bar={ups}  improvement_ratio={ir}")
+    return None

@@ -1,0 +1,117 @@
+"""Experiment runner: definitions, resume, invalidation, report, CLI."""
+
+import json
+import os
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from safepg import experiments as ex
+from safepg.cli import main
+
+
+@pytest.fixture()
+def root(tmp_path, monkeypatch):
+    monkeypatch.setenv("SAFEPG_RESULTS", str(tmp_path))
+    return tmp_path
+
+
+def small(name="table-5.2", configs=3, budget=3000, seeds=2):
+    e = ex.get_experiment(name)
+    return ex.scaled(replace(e, configs=e.configs[:configs]), seeds, budget)
+
+
+def test_definitions_match_the_thesis():
+    t51, t52 = ex.get_experiment("table-5.1"), ex.get_experiment("table-5.2")
+    assert len(t51.configs) == 24 and {c.budget for c in t51.configs} == {1_000_000}
+    assert {(c.sigma, c.batch_size, c.alpha) for c in t51.configs} == {
+        (s, n, a) for s in (0.5, 1.0) for n in (10_000, 1_000, 100) for a in (1e-3, 1e-4, 1e-5, 1e-6)}
+    assert all(c.theta0 == (-0.55,) and c.estimator == "gpomdp" for c in t51.configs)
+    assert len(t52.configs) == 12 and t52.seeds == 5
+    assert all(c.budget == 30_000_000 and c.theta0 == (0.0,) and c.sigma == 1.0 for c in t52.configs)
+    assert sum(c.estimator == "reinforce" for c in t52.configs) == 3
+    assert len({c.key() for c in t52.configs}) == 12
+    for c in t52.configs:
+        lo, hi = t52.thesis[c.name]["ci95"]
+        assert lo <= t52.thesis[c.name]["upsilon_bar"] <= hi
+
+
+def test_run_resume_and_invalidation(root, monkeypatch):
+    exp = small()
+    recs = ex.run_experiment(exp, jobs=1, progress=False)
+    assert all(len(v) == 2 for v in recs.values())
+    files = sorted(root.rglob("*.npz"))
+    assert len(files) == 6
+    stamp = {f: f.stat().st_mtime_ns for f in files}
+    calls = []
+    monkeypatch.setattr(ex.RunConfig, "run", lambda self, k, progress=False: calls.append((self.name, k)))
+    again = ex.run_experiment(exp, jobs=1, progress=False)
+    assert calls == [] and all(f.stat().st_mtime_ns == stamp[f] for f in files)
+    for name in recs:
+        assert all(np.array_equal(a.theta, b.theta) for a, b in zip(recs[name], again[name]))
+    # Changing one config's settings invalidates only its runs.
+    changed = replace(exp, configs=(replace(exp.configs[0], delta=0.9),) + exp.configs[1:])
+    assert ex._stored(ex.run_path(changed, changed.configs[0], 0), changed.configs[0]) is None
+    assert ex._stored(ex.run_path(changed, changed.configs[1], 0), changed.configs[1]) is not None
+
+
+def test_same_results_in_parallel_and_serial(root, tmp_path_factory):
+    exp = small(configs=2, seeds=2)
+    serial = ex.run_experiment(exp, jobs=1, progress=False)
+    par = ex.run_experiment(exp, jobs=2, progress=False, root=tmp_path_factory.mktemp("par"))
+    for name in serial:
+        assert all(np.array_equal(a.theta, b.theta) for a, b in zip(serial[name], par[name]))
+
+
+def test_interrupted_or_partial_files_are_recomputed(root):
+    exp = small(configs=1, seeds=1)
+    cfg = exp.configs[0]
+    path = ex.run_path(exp, cfg, 0)
+    path.parent.mkdir(parents=True)
+    path.write_bytes(b"half a file")
+    assert ex._stored(path, cfg) is None
+    ex.run_experiment(exp, jobs=1, progress=False)
+    assert ex._stored(path, cfg) is not None
+    assert not list(path.parent.glob("*.tmp.npz"))
+
+
+def test_report_structure(root):
+    exp = small(configs=2, seeds=3, budget=120_000)
+    rep = ex.report(exp, ex.run_experiment(exp, jobs=1, progress=False))
+    assert rep["experiment"] == "table-5.2" and len(rep["configs"]) == 2
+    row = rep["configs"][0]
+    for key in ("name", "estimator", "bound", "empirical_range", "delta", "sigma", "seeds",
+                "upsilon_bar", "improvement_ratio", "J_at", "J_final", "thesis"):
+        assert key in row
+    assert row["seeds"] == 3 and row["estimator"] == "reinforce" and row["bound"] == "chebyshev"
+    lo, hi = row["upsilon_bar"]["ci95"]
+    assert lo <= row["upsilon_bar"]["mean"] <= hi
+    assert list(row["J_at"]) == ["100000"]
+    assert row["thesis"]["upsilon_bar"] == -11.3266
+
+
+def test_mean_ci95_matches_scipy():
+    from scipy import stats
+    x = [1.0, 2.0, 4.0, 3.5, 2.2]
+    lo, hi = stats.t.interval(0.95, len(x) - 1, loc=np.mean(x), scale=stats.sem(x))
+    assert ex.mean_ci95(x)["ci95"] == pytest.approx([lo, hi])
+
+
+def test_cli_list_run_report(root, capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "table-5.1" in out and "table-5.2" in out
+    assert main(["run", "table-5.1", "--seeds", "1", "--budget", "20000", "--jobs", "2", "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["report", "table-5.1", "--seeds", "1", "--budget", "20000", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["experiment"] == "table-5.1" and len(rep["configs"]) == 24
+    row = rep["configs"][0]
+    assert row["batch_size"] == 10_000 and row["alpha"] == 1e-3 and row["seeds"] == 1
+    assert row["thesis"] == {"improvement_ratio": 0.9596}
+
+
+def test_unknown_experiment():
+    with pytest.raises(ValueError, match="^experiment"):
+        ex.get_experiment("table-9")
