@@ -23,7 +23,6 @@ from safepg.estimators import gradient_samples
 from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant
 from safepg.policies import LinearGaussianPolicy
 
-
 FUSED = True
 
 
@@ -67,8 +66,8 @@ def main() -> None:
     rows = []
     for n in (10_000, 100_000, 1_000_000):
         rng = np.random.default_rng(0)
-        t_it = best_time(lambda: one_iteration(env, pol, n, rng), args.repeat)
-        t_fl = best_time(lambda: floor(env, n, rng), args.repeat)
+        t_it = best_time(lambda n=n, rng=rng: one_iteration(env, pol, n, rng), args.repeat)
+        t_fl = best_time(lambda n=n, rng=rng: floor(env, n, rng), args.repeat)
         steps = n * env.horizon
         rows.append(dict(N=n, iteration_s=t_it, floor_s=t_fl, steps_per_s=steps / t_it,
                          floor_steps_per_s=steps / t_fl, speed_vs_floor=t_fl / t_it))

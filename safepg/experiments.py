@@ -334,7 +334,6 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def _cmd_list(args: argparse.Namespace) -> None:
     for e in EXPERIMENTS.values():
         print(f"{e.name:12s} {len(e.configs):3d} configs x {e.seeds} seeds  {e.description}")
-    return None
 
 
 def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:

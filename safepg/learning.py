@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Literal, Protocol
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -20,8 +21,13 @@ from safepg._rng import RNGLike, as_generator
 from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
 from safepg.constants import BoundedTask, TaskConstants
 from safepg.estimators import Estimator, ScoreAction, gradient_samples
-from safepg.meta import coordinate_step, guaranteed_improvement, optimal_batch_size
-from safepg.meta import penalty_constant, scalar_step
+from safepg.meta import (
+    coordinate_step,
+    guaranteed_improvement,
+    optimal_batch_size,
+    penalty_constant,
+    scalar_step,
+)
 from safepg.policies import LinearGaussianPolicy
 from safepg.trajectories import Trajectories
 
@@ -403,4 +409,4 @@ def vanilla_pg(
     return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress)
 
 
-__all__ = ["LearningRecord", "adaptive_pg", "vanilla_pg", "guaranteed_improvement", "CHECKPOINTS"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]

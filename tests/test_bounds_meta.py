@@ -7,13 +7,31 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from safepg.bounds import (ErrorBound, bernstein, chebyshev, error_bound, gpomdp_variance_factor,
-                           gradient_range_bound, hoeffding, reinforce_variance_factor)
+from safepg.bounds import (
+    ErrorBound,
+    bernstein,
+    chebyshev,
+    error_bound,
+    gpomdp_variance_factor,
+    gradient_range_bound,
+    hoeffding,
+    reinforce_variance_factor,
+)
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.meta import (ALPHA_STAR_FACTOR, coordinate_step, guaranteed_improvement,
-                         n_star_bernstein_root, n_star_closed_form, n_star_search, n_zero,
-                         optimal_batch_size, penalty_constant, scalar_step, upsilon)
+from safepg.meta import (
+    ALPHA_STAR_FACTOR,
+    coordinate_step,
+    guaranteed_improvement,
+    n_star_bernstein_root,
+    n_star_closed_form,
+    n_star_search,
+    n_zero,
+    optimal_batch_size,
+    penalty_constant,
+    scalar_step,
+    upsilon,
+)
 
 K1 = TaskConstants.from_task(LQG.thesis_1d(), 1.0)
 pos = st.floats(min_value=1e-2, max_value=1e2, allow_nan=False)

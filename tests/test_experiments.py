@@ -1,7 +1,6 @@
 """Experiment runner: definitions, resume, invalidation, report, CLI."""
 
 import json
-import os
 from dataclasses import replace
 
 import numpy as np

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from safepg.cli import main
+from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
-from safepg.constants import TaskConstants
 
 ENV = LQG.thesis_1d()
 ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe")

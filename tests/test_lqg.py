@@ -91,7 +91,7 @@ def test_optimal_gain_matches_brute_force_search():
 
 def test_optimum_is_independent_of_sigma():
     env = LQG.thesis_1d()
-    ts = [minimize_scalar(lambda t: -env.performance(t, s), bounds=(-1.5, 0.2), method="bounded",
+    ts = [minimize_scalar(lambda t, s=s: -env.performance(t, s), bounds=(-1.5, 0.2), method="bounded",
                           options={"xatol": 1e-10}).x for s in (0.3, 2.0)]
     assert ts[0] == pytest.approx(ts[1], abs=1e-6)
 
