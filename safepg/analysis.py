@@ -97,3 +97,68 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, 
     sep = "|" + "|".join("---" for _ in columns) + "|"
     body = ["| " + " | ".join(fmt(r.get(k), s) for k, _, s in columns) + " |" for r in rows]
     return "\n".join([head, sep, *body])
+
+
+# ------------------------------------------------------------------ estimators and objectives
+def simulated_performance(env: Any, thetas: Sequence[float] | np.ndarray, sigma: float, n: int,
+                          seed: int = 0, score_action: str = "clipped") -> np.ndarray:
+    """Monte Carlo estimate of the simulator's objective (clipped, H-step discounted return)
+    at each theta, with common random numbers: every theta sees the same initial states and
+    noise, so differences between thetas are estimated far more precisely than the values."""
+    from safepg.policies import LinearGaussianPolicy
+
+    out = []
+    for theta in np.atleast_1d(np.asarray(thetas, dtype=float)):
+        pol = LinearGaussianPolicy(np.reshape(theta, (env.dim, -1)), sigma)
+        out.append(env.gradient_batch(pol, n, np.random.default_rng(seed), "gpomdp", False, score_action)[1].mean())
+    return np.asarray(out)
+
+
+def simulated_gradient(env: Any, theta: float, sigma: float, n: int, seed: int = 0, h: float = 1e-4) -> float:
+    """Central finite difference of :func:`simulated_performance` (common random numbers):
+    the gradient of the objective the simulator really optimises (1-D)."""
+    lo, hi = simulated_performance(env, [theta - h, theta + h], sigma, n, seed)
+    return float((hi - lo) / (2 * h))
+
+
+def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequence[int], repeats: int,
+                       seed: int = 0, estimators: Sequence[str] = ("reinforce", "gpomdp"),
+                       score_action: str = "clipped") -> dict[str, np.ndarray]:
+    """Batch gradient estimates (with baseline) for each estimator and batch size N:
+    ``{estimator: array (len(batch_sizes), repeats)}``; every repeat is an independent batch,
+    and the estimators share each batch's random numbers."""
+    from safepg.policies import LinearGaussianPolicy
+
+    pol = LinearGaussianPolicy([[theta]], sigma)
+    rng = np.random.default_rng(seed)
+    out = {e: np.empty((len(batch_sizes), repeats)) for e in estimators}
+    for i, n in enumerate(batch_sizes):
+        for r in range(repeats):
+            state = rng.bit_generator.state
+            for e in estimators:
+                rng.bit_generator.state = state  # same trajectories for every estimator
+                out[e][i, r] = env.gradient_batch(pol, int(n), rng, e, True, score_action)[0].mean()
+    return out
+
+
+def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, seed: int = 0,
+                    estimators: Sequence[str] = ("reinforce", "gpomdp"), baseline: bool = True) -> dict[str, np.ndarray]:
+    """Per-trajectory variance of each estimator's gradient sample as sigma varies (1-D)."""
+    from safepg.policies import LinearGaussianPolicy
+
+    out = {e: np.empty(len(sigmas)) for e in estimators}
+    for i, s in enumerate(sigmas):
+        pol = LinearGaussianPolicy([[theta]], s)
+        for e in estimators:
+            out[e][i] = env.gradient_batch(pol, n, np.random.default_rng(seed), e, baseline)[0].var(ddof=1)
+    return out
+
+
+def improvement_ratio_on(records: Sequence[LearningRecord], objective: Any) -> np.ndarray:
+    """Improvement ratio of each run measured with another objective, ``objective(theta_array)``
+    (e.g. an interpolant of :func:`simulated_performance`), instead of the closed-form J."""
+    out = []
+    for r in records:
+        vals = objective(r.theta[:, 0] if r.theta.shape[1] == 1 else r.theta)
+        out.append(float(np.mean(np.diff(vals) >= 0)))
+    return np.asarray(out)

@@ -35,3 +35,34 @@ def test_table_5_2_differences():
     assert abs(row["difference"] - (-9.7 + 9.6623)) < 1e-12
     md = markdown_table([row], [("ours", "ours", ".3f"), ("ci95", "CI", ".1f"), ("missing", "x", "")])
     assert md.splitlines()[2] == "| -9.700 | [-9.8; -9.6] | - |"
+
+
+def test_simulated_gradient_matches_settings_value():
+    # SETTINGS.md: at theta = -0.3 the finite difference of the simulated return is about -3.870.
+    from safepg.analysis import simulated_gradient, simulated_performance
+    from safepg.envs.lqg import LQG
+
+    env = LQG.thesis_1d()
+    g = simulated_gradient(env, -0.3, 1.0, 200_000, seed=1)
+    assert abs(g - (-3.870)) < 0.03
+    assert abs(simulated_performance(env, [-0.3], 1.0, 200_000, 2)[0] - (-10.15)) < 0.05
+
+
+def test_gradient_estimates_share_batches_and_concentrate():
+    from safepg.analysis import gradient_estimates
+    from safepg.envs.lqg import LQG
+
+    est = gradient_estimates(LQG.thesis_1d(), -0.3, 1.0, [100, 10_000], repeats=20, seed=0)
+    assert est["gpomdp"].shape == (2, 20)
+    for e in est.values():
+        assert e[1].std() < e[0].std() / 4  # 100x the samples: about 10x less spread
+    assert np.std(est["gpomdp"][0]) < np.std(est["reinforce"][0])
+
+
+def test_improvement_ratio_on_other_objective():
+    from safepg.analysis import improvement_ratio_on
+
+    r = rec([1, 1, 1], [0, 0, 0, 0])
+    r.theta[:, 0] = [0.0, 0.1, 0.05, 0.2]
+    assert improvement_ratio_on([r], lambda t: t)[0] == 2 / 3
+    assert improvement_ratio_on([r], lambda t: -t)[0] == 1 / 3
