@@ -142,7 +142,8 @@ def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequen
 
 
 def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, seed: int = 0,
-                    estimators: Sequence[str] = ("reinforce", "gpomdp"), baseline: bool = True) -> dict[str, np.ndarray]:
+                    estimators: Sequence[str] = ("reinforce", "gpomdp"),
+                    baseline: bool = True) -> dict[str, np.ndarray]:
     """Per-trajectory variance of each estimator's gradient sample as sigma varies (1-D)."""
     from safepg.policies import LinearGaussianPolicy
 
