@@ -102,6 +102,7 @@ def error_bound(
     constants: TaskConstants,
     estimator: str = "gpomdp",
     empirical_range: bool = False,
+    theoretical_range: float | None = None,
 ) -> ErrorBound:
     """The bound of Section 4.3 for one gradient component.
 
@@ -118,6 +119,8 @@ def error_bound(
     empirical_range : bool
         Hoeffding/Bernstein: use max - min of ``samples`` (the thesis's "e.r.")
         instead of Lemma 4.3.3's range.
+    theoretical_range : float, optional
+        Replace Lemma 4.3.3's range (used when ``empirical_range`` is False) by this value.
     """
     check_delta(delta)
     samples = np.asarray(samples, dtype=float)
@@ -131,7 +134,14 @@ def error_bound(
         raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
     if bound not in ("hoeffding", "bernstein"):
         raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
-    grad_range = float(np.ptp(samples)) if empirical_range else gradient_range_bound(constants)
+    if empirical_range:
+        grad_range = float(np.ptp(samples))
+    elif theoretical_range is not None:
+        if not (np.isfinite(theoretical_range) and theoretical_range > 0):
+            raise ValueError(f"theoretical_range must be finite and > 0, got {theoretical_range}")
+        grad_range = float(theoretical_range)
+    else:
+        grad_range = gradient_range_bound(constants)
     if bound == "hoeffding":
         return hoeffding(delta, grad_range)
     return bernstein(delta, float(np.var(samples, ddof=1)), grad_range)

@@ -282,6 +282,7 @@ def adaptive_pg(
     bound: Bound = "chebyshev",
     delta: float = 0.95,
     empirical_range: bool = False,
+    theoretical_range: float | None = None,
     n_min: int = 100,
     n_max: int = 500_000,
     budget: int = 30_000_000,
@@ -308,6 +309,7 @@ def adaptive_pg(
     bound : "chebyshev", "hoeffding" or "bernstein"
     delta : probability of a worsening update, in (0, 1)
     empirical_range : Hoeffding/Bernstein with the batch's max - min instead of Lemma 4.3.3
+    theoretical_range : replaces Lemma 4.3.3's range when ``empirical_range`` is False
     n_min, n_max : batch-size limits
     budget : total number of trajectories
     score_action : "clipped" (the authors' code) or "raw" (unbiased score)
@@ -328,7 +330,8 @@ def adaptive_pg(
         grad = samples.mean(axis=0)
         k = int(np.argmax(np.abs(grad)))
         g = float(abs(grad[k]))
-        eb: ErrorBound = error_bound(bound, samples[:, k], delta, constants, estimator, empirical_range)
+        eb: ErrorBound = error_bound(bound, samples[:, k], delta, constants, estimator, empirical_range,
+                                     theoretical_range)
         eps = float(eb.eps(n))
         alpha = coordinate_step(g, eps, c)
         step = np.zeros_like(grad)
@@ -338,8 +341,8 @@ def adaptive_pg(
     config = dict(
         algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
         sigma=sigma, estimator=estimator, baseline=baseline, bound=bound, delta=delta,
-        empirical_range=empirical_range, n_min=n_min, n_max=n_max, budget=budget,
-        score_action=score_action, c=c,
+        empirical_range=empirical_range, theoretical_range=theoretical_range, n_min=n_min, n_max=n_max,
+        budget=budget, score_action=score_action, c=c,
     )
     return _learn(task, policy, rule, n_min, budget, rng, estimator, baseline, score_action, config, progress)
 

@@ -177,3 +177,11 @@ def test_bad_constants_raise():
         error_bound("markov", np.ones(3), 0.5, K1)
     with pytest.raises(ValueError, match="^gradient norm"):
         coordinate_step(float("nan"), 0.1, 1.0)
+
+
+def test_theoretical_range_override():
+    x = np.arange(10.0)
+    assert error_bound("hoeffding", x, 0.5, K1, theoretical_range=1280.0).d == pytest.approx(
+        1280.0 * math.sqrt(math.log(4) / 2))
+    with pytest.raises(ValueError, match="^theoretical_range"):
+        error_bound("hoeffding", x, 0.5, K1, theoretical_range=-1.0)
