@@ -163,3 +163,16 @@ def improvement_ratio_on(records: Sequence[LearningRecord], objective: Any) -> n
         vals = objective(r.theta[:, 0] if r.theta.shape[1] == 1 else r.theta)
         out.append(float(np.mean(np.diff(vals) >= 0)))
     return np.asarray(out)
+
+
+def simulated_objective(env: Any, sigma: float, lo: float, hi: float, points: int = 61, n: int = 200_000,
+                        seed: int = 0) -> Any:
+    """Cubic-spline interpolant of :func:`simulated_performance` on [lo, hi] (1-D).
+
+    With common random numbers the sampled curve is smooth in theta, so the spline can
+    tell whether a step of 1e-5 went up or down the simulator's objective.
+    """
+    from scipy.interpolate import CubicSpline
+
+    grid = np.linspace(lo, hi, points)
+    return CubicSpline(grid, simulated_performance(env, grid, sigma, n, seed))
