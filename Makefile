@@ -2,7 +2,7 @@
 PYTHON ?= python3
 PIP := $(PYTHON) -m pip
 
-.PHONY: setup browser-deps test test-lib book bench
+.PHONY: setup browser-deps test test-lib book book-assets bench
 
 setup:
 	$(PIP) install --quiet --disable-pip-version-check -r requirements.txt
@@ -18,6 +18,15 @@ test: setup browser-deps
 
 test-lib: setup
 	$(PYTHON) -m pytest tests -m "not browser"
+
+# MathJax from the npm registry into book/_vendor: pages render math offline.
+book-assets:
+	bash book/tools/vendor_assets.sh
+
+# -W: warnings are errors (broken references, bad math); notebooks run through the cache.
+book: setup book-assets
+	bash book/tools/cache_guard.sh
+	jupyter-book build . -W -n --keep-going
 
 bench: setup
 	$(PYTHON) benchmarks/bench_iteration.py

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Jupyter Book's execution cache is keyed on the notebooks' code only; clear it when
+# the library changed since the last build, so no page shows stale safepg output.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+stamp=_build/.safepg-hash
+now=$(cat safepg/*.py safepg/envs/*.py | sha256sum | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$now" ]; then
+  rm -rf _build/.jupyter_cache
+  mkdir -p _build
+  echo "$now" > "$stamp"
+fi

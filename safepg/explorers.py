@@ -1,0 +1,230 @@
+"""The book's explorers, built on :class:`safepg.explorer.Explorer`.
+
+Each factory returns an explorer whose JavaScript and Python halves compute the same
+curves: closed forms in both, precomputed Monte Carlo quantities embedded as data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from safepg import plotting
+from safepg.analysis import by_iteration, mean_band, performance_on_grid
+from safepg.bounds import ErrorBound, bernstein, chebyshev, gpomdp_variance_factor, gradient_range_bound
+from safepg.bounds import hoeffding, reinforce_variance_factor
+from safepg.constants import TaskConstants
+from safepg.envs.lqg import LQG
+from safepg.explorer import Explorer, Plot, Select, Slider
+from safepg.learning import LearningRecord
+from safepg.meta import coordinate_step, guaranteed_improvement, n_star_closed_form, n_star_search, n_zero
+from safepg.meta import penalty_constant, upsilon
+
+# ---------------------------------------------------------------------------- LQG
+_LQG_JS = r"""
+const th = lib.linspace(data.theta_min, data.theta_max, data.points);
+const J = th.map(t => lib.lqgJ(t, p.sigma, data.gamma, data.b));
+const js = lib.lqgJ(data.theta_star, p.sigma, data.gamma, data.b);
+const interp = (xs, ys, x) => { let i = 1; while (i < xs.length - 1 && xs[i] < x) i++;
+  const w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]); return ys[i - 1] + w * (ys[i] - ys[i - 1]); };
+const vr = interp(data.sigmas, data.var_reinforce, p.sigma), vg = interp(data.sigmas, data.var_gpomdp, p.sigma);
+return {
+  plots: {
+    J: {series: [{label: "J(theta), sigma = " + p.sigma, x: th, y: J, color: data.accent}],
+        markers: [{x: data.theta_star, y: js, label: "theta*", color: data.accent}]},
+    var: {series: [{label: "REINFORCE", x: data.sigmas, y: data.var_reinforce, color: data.c_rf, dash: true},
+                   {label: "G(PO)MDP", x: data.sigmas, y: data.var_gpomdp, color: data.c_gp}],
+          markers: [{x: p.sigma, y: vr, color: data.c_rf}, {x: p.sigma, y: vg, color: data.c_gp}]},
+  },
+  values: {J_star: js, var_reinforce: vr, var_gpomdp: vg},
+  text: `J(theta*) = ${js.toFixed(3)} at theta* = ${data.theta_star.toFixed(4)}; per-trajectory variance at theta = ${data.theta_var}: REINFORCE ${vr.toFixed(1)}, G(PO)MDP ${vg.toFixed(1)}`,
+};
+"""
+
+
+def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_var: float = -0.3,
+                 seed: int = 0) -> Explorer:
+    """1-D LQG: the closed-form J(theta) as sigma moves (theta* marked), beside the
+    per-trajectory variance of the REINFORCE and G(PO)MDP samples (Monte Carlo,
+    precomputed on a sigma grid)."""
+    from safepg.analysis import sample_variance
+
+    env = LQG.thesis_1d()
+    sigmas = np.round(np.linspace(0.2, 2.0, 19), 3) if sigmas is None else np.asarray(sigmas)
+    var = sample_variance(env, theta_var, sigmas, n, seed)
+    data = {"theta_min": -1.2, "theta_max": 0.04, "points": 125, "gamma": env.gamma, "b": env.state_bound,
+            "theta_star": float(env.optimal_gain().item()), "sigmas": sigmas.tolist(), "theta_var": theta_var,
+            "var_reinforce": var["reinforce"].tolist(), "var_gpomdp": var["gpomdp"].tolist(),
+            "accent": plotting.ACCENT, "c_rf": plotting.MUTED, "c_gp": plotting.ACCENT}
+
+    def compute_py(p: dict[str, Any]) -> dict[str, Any]:
+        th = np.linspace(data["theta_min"], data["theta_max"], data["points"])
+        J = [env.performance(t, p["sigma"]) for t in th]
+        js = env.performance(data["theta_star"], p["sigma"])
+        vr = float(np.interp(p["sigma"], sigmas, data["var_reinforce"]))
+        vg = float(np.interp(p["sigma"], sigmas, data["var_gpomdp"]))
+        return {"plots": {"J": {"series": [{"x": th.tolist(), "y": J}],
+                                "markers": [{"x": data["theta_star"], "y": js}]},
+                          "var": {"series": [{"x": sigmas.tolist(), "y": data["var_reinforce"]},
+                                             {"x": sigmas.tolist(), "y": data["var_gpomdp"]}],
+                                  "markers": [{"x": p["sigma"], "y": vr}, {"x": p["sigma"], "y": vg}]}},
+                "values": {"J_star": js, "var_reinforce": vr, "var_gpomdp": vg}}
+
+    return Explorer(
+        "1-D LQG: expected performance and estimator variance",
+        [Slider("sigma", "policy std sigma", 0.2, 2.0, 0.05, 1.0)],
+        [Plot("J", "theta", "J(theta)", ymin=-120, ymax=0),
+         Plot("var", "sigma", "per-trajectory variance", ylog=True)],
+        _LQG_JS, compute_py, data)
+
+
+# ------------------------------------------------------------------------ Upsilon
+BOUND_CHOICES = (
+    ("chebyshev-gpomdp", "Chebyshev, G(PO)MDP variance bound"),
+    ("chebyshev-reinforce", "Chebyshev, REINFORCE variance bound"),
+    ("hoeffding", "Hoeffding, Lemma 4.3.3 range"),
+    ("hoeffding-er", "Hoeffding, empirical range"),
+    ("bernstein", "Bernstein, Lemma 4.3.3 range"),
+    ("bernstein-er", "Bernstein, empirical range"),
+)
+
+_UPSILON_JS = r"""
+const k = {R: data.R, M: data.M, Avol: data.Avol, Abar: data.Abar, gamma: data.gamma, H: data.H, sigma: p.sigma};
+const c = lib.penalty(k), g = p.g;
+const interp = (xs, ys, x) => { let i = 1; while (i < xs.length - 1 && xs[i] < x) i++;
+  const w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]); return ys[i - 1] + w * (ys[i] - ys[i - 1]); };
+const S = interp(data.sigmas, data.sample_var, p.sigma), er = interp(data.sigmas, data.emp_range, p.sigma);
+let bd;
+if (p.bound === "chebyshev-gpomdp") bd = lib.chebyshev(p.delta, lib.varGpomdp(k));
+else if (p.bound === "chebyshev-reinforce") bd = lib.chebyshev(p.delta, lib.varReinforce(k));
+else if (p.bound === "hoeffding") bd = lib.hoeffding(p.delta, lib.rangeBound(k));
+else if (p.bound === "hoeffding-er") bd = lib.hoeffding(p.delta, er);
+else if (p.bound === "bernstein") bd = lib.bernstein(p.delta, S, lib.rangeBound(k));
+else bd = lib.bernstein(p.delta, S, er);
+const n0 = lib.nZero(g, bd), ns = lib.nStar(g, bd, c);
+const N = lib.geomspace(Math.max(1, n0), 6 * ns, data.points);
+const U = N.map(n => lib.upsilon(n, g, bd, c));
+const e = lib.eps(bd, ns), a = lib.step(g, e, c), imp = lib.improvement(g, e, c);
+return {
+  plots: {U: {series: [{label: "Upsilon(N)", x: N, y: U, color: data.accent}],
+              markers: [{x: n0, y: 0, label: "N0", color: data.muted},
+                        {x: ns, y: lib.upsilon(ns, g, bd, c), label: "N*", color: data.accent}]}},
+  values: {c: c, d: bd.d, f: bd.f, N0: n0, Nstar: ns, alpha: a, improvement: imp},
+  text: `c = ${c.toPrecision(5)}, d = ${bd.d.toPrecision(5)}, f = ${bd.f.toPrecision(5)}<br>` +
+        `N0 = ${n0.toFixed(1)}, N* = ${ns}, step alpha* = ${a.toExponential(4)}, guaranteed improvement = ${imp.toExponential(4)}`,
+};
+"""
+
+
+def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta: float = 0.0,
+                     seed: int = 0) -> Explorer:
+    """Upsilon_delta(N) for the 1-D LQG: sliders for delta, sigma and ||g||_inf, and a
+    bound selector; marks N_0 and N* and prints N*, the step and the guaranteed
+    improvement. The empirical quantities (sample variance and range of the G(PO)MDP
+    samples) come from real batches at ``theta`` on a sigma grid."""
+    env = LQG.thesis_1d()
+    sigmas = np.round(np.linspace(0.5, 2.0, 16), 3) if sigmas is None else np.asarray(sigmas)
+    from safepg.policies import LinearGaussianPolicy
+
+    svar, srange = [], []
+    for s in sigmas:
+        x = env.gradient_batch(LinearGaussianPolicy([[theta]], s), n, np.random.default_rng(seed))[0][:, 0]
+        svar.append(float(np.var(x, ddof=1)))
+        srange.append(float(np.ptp(x)))
+    data = {"R": env.reward_bound, "M": env.feature_bound, "Avol": env.action_volume, "Abar": env.action_bound,
+            "gamma": env.gamma, "H": env.horizon, "sigmas": sigmas.tolist(), "sample_var": svar,
+            "emp_range": srange, "points": 200, "accent": plotting.ACCENT, "muted": plotting.MUTED}
+
+    def bound_for(p: dict[str, Any]) -> tuple[ErrorBound, float]:
+        k = TaskConstants.from_task(env, p["sigma"])
+        S = float(np.interp(p["sigma"], sigmas, svar))
+        er = float(np.interp(p["sigma"], sigmas, srange))
+        b = p["bound"]
+        bd = {"chebyshev-gpomdp": lambda: chebyshev(p["delta"], gpomdp_variance_factor(k)),
+              "chebyshev-reinforce": lambda: chebyshev(p["delta"], reinforce_variance_factor(k)),
+              "hoeffding": lambda: hoeffding(p["delta"], gradient_range_bound(k)),
+              "hoeffding-er": lambda: hoeffding(p["delta"], er),
+              "bernstein": lambda: bernstein(p["delta"], S, gradient_range_bound(k)),
+              "bernstein-er": lambda: bernstein(p["delta"], S, er)}[b]()
+        return bd, penalty_constant(k)
+
+    def compute_py(p: dict[str, Any]) -> dict[str, Any]:
+        bd, c = bound_for(p)
+        g = p["g"]
+        n0 = n_zero(g, bd)
+        ns = n_star_closed_form(g, bd) if bd.f == 0 else n_star_search(g, bd, c)
+        N = np.geomspace(max(1.0, n0), 6 * ns, data["points"])
+        e = bd.eps(ns)
+        return {"plots": {"U": {"series": [{"x": N.tolist(), "y": upsilon(N, g, bd, c, saturate=False).tolist()}],
+                                "markers": [{"x": n0, "y": 0.0}, {"x": ns, "y": upsilon(ns, g, bd, c)}]}},
+                "values": {"c": c, "d": bd.d, "f": bd.f, "N0": n0, "Nstar": ns,
+                           "alpha": coordinate_step(g, e, c), "improvement": guaranteed_improvement(g, e, c)}}
+
+    return Explorer(
+        "Upsilon_delta(N): the cost-sensitive improvement (Section 4.3)",
+        [Slider("delta", "delta", 0.05, 0.95, 0.05, 0.95), Slider("sigma", "sigma", 0.5, 2.0, 0.1, 1.0),
+         Slider("g", "||g||_inf", 1.0, 60.0, 1.0, 30.0),
+         Select("bound", "bound", BOUND_CHOICES, "bernstein-er")],
+        [Plot("U", "batch size N", "Upsilon_delta(N)", xlog=True)],
+        _UPSILON_JS, compute_py, data)
+
+
+# --------------------------------------------------------------------- batch size
+_BATCH_JS = r"""
+const key = `${p.estimator}-${p.bound}-delta=${p.delta}`;
+const run = data.runs[key];
+if (!run) return {plots: {N: {series: []}, J: {series: []}}, values: {key: key, found: false},
+                  text: `${key}: not among the thesis's runs (Table 5.2)`};
+return {
+  plots: {N: {series: [{label: "batch size", x: run.iteration, y: run.batch_size, color: run.color}]},
+          J: {series: [{label: "J(theta)", x: data.grid, y: run.J, color: run.color, dash: p.estimator === "reinforce"}]}},
+  values: {key: key, found: true, final_batch: run.batch_size[run.batch_size.length - 1], J_final: run.J[run.J.length - 1]},
+  text: `${key}: ${run.iterations.toFixed(0)} iterations (seed mean); upsilon_bar = ${run.upsilon_bar.toFixed(4)}`,
+};
+"""
+
+
+def batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence[Any],
+                        points: int = 300) -> Explorer:
+    """Batch size over iterations and expected performance over trajectories of the stored
+    Table 5.2 runs (seed means): pick the estimator, the bound and delta."""
+    runs: dict[str, Any] = {}
+    total = max(r.trajectories for recs in records.values() for r in recs)
+    grid = np.unique(np.linspace(1, total, points).astype(np.int64))
+    for c in configs:
+        recs = records[c.name]
+        if not recs:
+            continue
+        nmean = mean_band(by_iteration(recs, "batch_size"))[0]
+        keep = np.unique(np.linspace(0, nmean.size - 1, min(points, nmean.size)).astype(int))
+        bound = c.bound + ("-er" if c.empirical_range else "")
+        runs[f"{c.estimator}-{bound}-delta={c.delta}"] = {
+            "iteration": (keep + 1).tolist(), "batch_size": np.round(nmean[keep], 1).tolist(),
+            "J": np.round(mean_band(performance_on_grid(recs, grid))[0], 5).tolist(),
+            "iterations": float(np.mean([r.iterations for r in recs])),
+            "upsilon_bar": float(np.mean([r.upsilon_bar() for r in recs])),
+            "color": plotting.bound_color(c.bound, c.empirical_range)}
+    data = {"grid": grid.tolist(), "runs": runs}
+    deltas = sorted({c.delta for c in configs})
+
+    def compute_py(p: dict[str, Any]) -> dict[str, Any]:
+        key = f"{p['estimator']}-{p['bound']}-delta={p['delta']}"
+        run = runs.get(key)
+        if run is None:
+            return {"values": {"key": key, "found": False}}
+        return {"plots": {"N": {"series": [{"x": run["iteration"], "y": run["batch_size"]}]},
+                          "J": {"series": [{"x": data["grid"], "y": run["J"]}]}},
+                "values": {"key": key, "found": True, "final_batch": run["batch_size"][-1], "J_final": run["J"][-1]}}
+
+    return Explorer(
+        "Adaptive batch size on the 1-D LQG (stored runs, mean of the seeds)",
+        [Select("estimator", "estimator", (("gpomdp", "G(PO)MDP"), ("reinforce", "REINFORCE")), "gpomdp"),
+         Select("bound", "bound", (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"),
+                                   ("hoeffding-er", "Hoeffding (e.r.)"), ("bernstein", "Bernstein"),
+                                   ("bernstein-er", "Bernstein (e.r.)")), "chebyshev"),
+         Select("delta", "delta", tuple((str(d), str(d)) for d in deltas), "0.95")],
+        [Plot("N", "iteration", "batch size N", ylog=True),
+         Plot("J", "trajectories", "expected performance J(theta)")],
+        _BATCH_JS, compute_py, data)

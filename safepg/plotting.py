@@ -1,0 +1,57 @@
+"""Shared plotting style: one colour per bound, one line style per estimator.
+
+The thesis draws G(PO)MDP solid and REINFORCE dashed; we keep that everywhere, and give
+each concentration bound one colour across all chapters (and the browser explorers,
+which read the same tables). Figures have a white background so they read the same in
+the book's light and dark themes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import matplotlib as mpl
+
+ESTIMATOR_LABELS = {"reinforce": "REINFORCE", "gpomdp": "G(PO)MDP"}
+ESTIMATOR_DASH = {"reinforce": "--", "gpomdp": "-"}
+BOUND_COLORS = {
+    ("chebyshev", False): "#3b6fb6",
+    ("hoeffding", False): "#d98c2b",
+    ("hoeffding", True): "#c0392b",
+    ("bernstein", False): "#2e9e5b",
+    ("bernstein", True): "#7d4fb0",
+}
+BOUND_LABELS = {"chebyshev": "Chebyshev", "hoeffding": "Hoeffding", "bernstein": "Bernstein"}
+#: Colour for single-curve figures (J(theta), Upsilon).
+ACCENT = "#3b6fb6"
+MUTED = "#7f7f7f"
+
+
+def use_style() -> None:
+    """Matplotlib defaults for the book."""
+    mpl.rcParams.update({
+        "figure.facecolor": "white", "axes.facecolor": "white", "savefig.facecolor": "white",
+        "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False,
+        "figure.dpi": 100, "font.size": 10, "legend.frameon": False,
+    })
+
+
+def estimator_style(estimator: str) -> dict[str, str]:
+    """Line style of an estimator (thesis: G(PO)MDP solid, REINFORCE dashed)."""
+    return {"linestyle": ESTIMATOR_DASH[estimator]}
+
+
+def bound_color(bound: str, empirical_range: bool = False) -> str:
+    """Colour of a concentration bound (Chebyshev has no range variant)."""
+    return BOUND_COLORS[(bound, bool(empirical_range) and bound != "chebyshev")]
+
+
+def bound_label(bound: str, empirical_range: bool = False) -> str:
+    return BOUND_LABELS[bound] + (" (e.r.)" if empirical_range else "")
+
+
+def delta_color(delta: float, deltas: Sequence[float]) -> str:
+    """Colour of one delta among several (viridis, darkest for the smallest delta)."""
+    ordered = sorted(deltas)
+    x = ordered.index(delta) / max(1, len(ordered) - 1)
+    return mpl.colors.to_hex(mpl.colormaps["viridis"](0.1 + 0.75 * x))

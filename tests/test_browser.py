@@ -1,0 +1,116 @@
+"""The built book in headless Chromium, opened from disk with no network.
+
+Builds the book (notebook execution is cached), opens pages as file:// URLs in Debian's
+Chromium driven by Playwright, and checks: no JavaScript error, no request leaves the
+disk, math typeset by the vendored MathJax, figures present, and that moving an
+explorer's slider redraws values equal to safepg's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HTML = ROOT / "_build" / "html"
+SHOTS = ROOT / "_build" / "screenshots"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="session")
+def book() -> Path:
+    if not Path(CHROMIUM).exists():
+        if os.environ.get("CI") == "true":
+            pytest.fail("chromium is not installed (make browser-deps)")
+        pytest.skip("chromium is not installed (make browser-deps)")
+    subprocess.run(["bash", "book/tools/vendor_assets.sh"], cwd=ROOT, check=True)
+    subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
+    subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
+                   stdout=subprocess.DEVNULL)
+    return HTML
+
+
+@pytest.fixture(scope="session")
+def browser(book):
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+class Page:
+    """A page with its console errors and any request that is not a local file."""
+
+    def __init__(self, browser, path: Path):
+        self.page = browser.new_page(viewport={"width": 1200, "height": 1600})
+        self.errors: list[str] = []
+        self.remote: list[str] = []
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.route("**/*", self._route)
+        self.page.goto(path.as_uri())
+        self.page.wait_for_load_state("load")
+
+    def _route(self, route):
+        if route.request.url.startswith("file://"):
+            route.continue_()
+        else:
+            self.remote.append(route.request.url)
+            route.abort()
+
+    def values(self, index: int = 0) -> dict:
+        return json.loads(self.page.locator(".safepg-values").nth(index).text_content())
+
+
+def _check_page(pg: Page, min_images: int) -> None:
+    pg.page.wait_for_selector("mjx-container", timeout=20_000)
+    assert pg.page.locator("mjx-container").count() > 5
+    assert pg.page.locator("img").count() >= min_images
+    for img in pg.page.locator("img").all():
+        assert img.evaluate("i => i.complete && i.naturalWidth > 0")
+    assert not pg.remote, f"requests left the disk: {pg.remote}"
+    assert not [e for e in pg.errors if "favicon" not in e], pg.errors
+
+
+def test_intro_renders(browser, book):
+    pg = Page(browser, book / "book" / "intro.html")
+    pg.page.wait_for_selector("mjx-container", timeout=20_000)
+    assert not pg.remote and not pg.errors
+
+
+def test_lqg_explorer_matches_safepg(browser, book):
+    from safepg.explorers import lqg_explorer
+
+    pg = Page(browser, book / "book" / "preliminaries.html")
+    _check_page(pg, min_images=3)
+    explorer = pg.page.locator(".safepg-explorer").first
+    explorer.scroll_into_view_if_needed()
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    explorer.screenshot(path=str(SHOTS / "lqg-before.png"))
+    before = pg.values()
+    assert before["params"] == {"sigma": 1.0}
+    assert pg.page.locator(".safepg-series").count() == 3
+
+    pg.page.locator('input[data-param="sigma"]').first.fill("0.5")
+    after = pg.values()
+    explorer.screenshot(path=str(SHOTS / "lqg-after.png"))
+    assert after["params"] == {"sigma": 0.5}
+    js_J = after["result"]["plots"]["J"]["series"][0]["y"]
+    assert js_J != before["result"]["plots"]["J"]["series"][0]["y"]
+
+    py = lqg_explorer().compute_py({"sigma": 0.5})
+    np.testing.assert_allclose(js_J, py["plots"]["J"]["series"][0]["y"], rtol=1e-9)
+    for key in ("J_star", "var_reinforce", "var_gpomdp"):
+        assert after["result"]["values"][key] == pytest.approx(py["values"][key], rel=1e-9)
