@@ -84,6 +84,17 @@ def table_5_2(report: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
+class Table(str):
+    """A Markdown table that renders as a table in notebooks and prints as its text
+    (so nbval compares the numbers, not an object's address)."""
+
+    def _repr_markdown_(self) -> str:
+        return str(self)
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
 def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, str, str]]) -> str:
     """A Markdown table from rows; ``columns`` holds (key, header, format spec)."""
     def fmt(v: Any, spec: str) -> str:
@@ -96,7 +107,7 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, 
     head = "| " + " | ".join(h for _, h, _ in columns) + " |"
     sep = "|" + "|".join("---" for _ in columns) + "|"
     body = ["| " + " | ".join(fmt(r.get(k), s) for k, _, s in columns) + " |" for r in rows]
-    return "\n".join([head, sep, *body])
+    return Table("\n".join([head, sep, *body]))
 
 
 # ------------------------------------------------------------------ estimators and objectives

@@ -190,7 +190,18 @@ def _table_5_2_range() -> Experiment:
                       tuple(configs), 5, thesis)
 
 
-EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (_table_5_1(), _table_5_2(), _table_5_2_range())}
+def _table_5_2_raw_score() -> Experiment:
+    t52 = _table_5_2()
+    keep = [t52_name("gpomdp", "chebyshev", False, 0.95), t52_name("gpomdp", "bernstein", True, 0.95)]
+    configs = tuple(replace(t52.config(n), name=f"{n}-raw-score", score_action="raw") for n in keep)
+    return Experiment("table-5.2-raw-score", "Two rows of Table 5.2 with the unbiased score of the sampled "
+                      "(unclipped) action instead of the authors' clipped-action score.", configs, 5,
+                      {f"{n}-raw-score": t52.thesis[n] for n in keep})
+
+
+EXPERIMENTS: dict[str, Experiment] = {
+    e.name: e for e in (_table_5_1(), _table_5_2(), _table_5_2_range(), _table_5_2_raw_score())
+}
 
 
 def get_experiment(name: str) -> Experiment:
