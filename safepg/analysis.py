@@ -68,6 +68,7 @@ def table_5_1(report: dict[str, Any]) -> list[dict[str, Any]]:
     for c in report["configs"]:
         ir = c["improvement_ratio"]
         rows.append({"sigma": c["sigma"], "N": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+                     "diverged": c.get("diverged", 0),
                      "ci95": ir["ci95"], **compare(ir["mean"], (c["thesis"] or {}).get("improvement_ratio"))})
     return rows
 

@@ -82,8 +82,9 @@ class RunConfig:
                                theoretical_range=self.theoretical_range, **common)
         if self.batch_size is None:
             raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
+        # A fixed step may diverge; that is a result to report, not an error.
         return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
-                          step=self.step, **common)
+                          step=self.step, stop_on_divergence=True, **common)
 
 
 def make_env(name: str) -> Any:
@@ -347,6 +348,7 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
             "J_at": j_at,
             "J_final": float(np.mean([r.J[-1] for r in recs])) if recs else None,
             "iterations": float(np.mean([r.iterations for r in recs])) if recs else None,
+            "diverged": sum(r.diverged for r in recs),
             "thesis": exp.thesis.get(c.name),
         })
     return {"experiment": exp.name, "configs": rows}

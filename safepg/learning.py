@@ -68,6 +68,9 @@ class LearningRecord:
         The settings of the run (JSON-serialisable).
     interrupted : bool
         The run was stopped early (KeyboardInterrupt); the arrays hold what was done.
+    diverged : bool
+        The run stopped because the gradient estimate overflowed (theta diverged under a
+        fixed step); only with ``stop_on_divergence=True``.
     """
 
     batch_size: np.ndarray
@@ -81,6 +84,7 @@ class LearningRecord:
     safe: np.ndarray
     config: dict[str, Any] = field(default_factory=dict)
     interrupted: bool = False
+    diverged: bool = False
 
     @property
     def iterations(self) -> int:
@@ -106,7 +110,8 @@ class LearningRecord:
         return of consecutive batches (Section 5.3, no closed form).
         """
         perf = self.J if on == "J" else self.J_hat
-        steps = np.diff(perf)
+        with np.errstate(invalid="ignore"):  # -inf to -inf (a diverged run) counts as no improvement
+            steps = np.diff(perf)
         if steps.size == 0:
             return float("nan")
         return float(np.mean(steps >= 0))
@@ -138,12 +143,13 @@ class LearningRecord:
             "improvement_ratio": self.improvement_ratio(),
             "batch_sizes": self.batch_size.tolist(),
             "interrupted": self.interrupted,
+            "diverged": self.diverged,
         }
 
     def save(self, path: str | Path) -> None:
         """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
         arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
-        meta = json.dumps({"config": self.config, "interrupted": self.interrupted})
+        meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged})
         np.savez_compressed(path, meta=np.array(meta), **arrays)
 
     @classmethod
@@ -151,7 +157,8 @@ class LearningRecord:
         with np.load(path) as z:
             meta = json.loads(str(z["meta"]))
             arrays = {k: z[k] for k in z.files if k != "meta"}
-        return cls(**arrays, config=meta["config"], interrupted=meta["interrupted"])
+        return cls(**arrays, config=meta["config"], interrupted=meta["interrupted"],
+                   diverged=meta.get("diverged", False))
 
 
 @dataclass(frozen=True)
@@ -207,6 +214,7 @@ def _learn(
     score_action: ScoreAction,
     config: dict[str, Any],
     progress: bool,
+    stop_on_divergence: bool = False,
 ) -> LearningRecord:
     rng = as_generator(rng)
     J = _closed_form(task, policy.sigma)
@@ -214,7 +222,7 @@ def _learn(
     thetas, Js = [theta.copy()], [J(theta)]
     rows: dict[str, list[Any]] = {k: [] for k in ("batch_size", "alpha", "coordinate", "J_hat", "grad", "eps", "safe")}
     used, n = 0, n_first
-    interrupted = False
+    interrupted = diverged = False
     bar = tqdm(total=budget, unit="traj", disable=not progress, leave=False, dynamic_ncols=True)
     try:
         while True:
@@ -225,6 +233,9 @@ def _learn(
             samples, returns = _collect(task, policy, n, rng, estimator, baseline, score_action)
             grad = samples.mean(axis=0)
             if not np.all(np.isfinite(grad)):
+                if stop_on_divergence:
+                    diverged = True
+                    break
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
             up = rule(samples, n)
             theta = theta + up.delta_theta
@@ -256,6 +267,7 @@ def _learn(
         safe=np.asarray(rows["safe"], dtype=bool),
         config=config,
         interrupted=interrupted,
+        diverged=diverged,
     )
 
 
@@ -364,6 +376,7 @@ def vanilla_pg(
     score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
     progress: bool = False,
+    stop_on_divergence: bool = False,
 ) -> LearningRecord:
     r"""Policy gradient with a fixed batch size.
 
@@ -371,7 +384,9 @@ def vanilla_pg(
     or only the largest component moves (``step="coordinate"``). With ``alpha=None`` the
     step is adaptive, using the bound's eps at the fixed N: the scalar step of [24]
     (``"scalar"``) or the coordinate step Lambda* of Corollary 4.2.8 (``"coordinate"``),
-    as compared in Section 5.2.1 (Figures 5.5-5.6).
+    as compared in Section 5.2.1 (Figures 5.5-5.6). A fixed step can make theta diverge
+    until the gradient overflows: with ``stop_on_divergence=True`` the run then ends and
+    the record says so (``diverged``), instead of raising.
     """
     if int(batch_size) != batch_size or batch_size < 2:
         raise ValueError(f"batch_size must be an integer >= 2, got {batch_size}")
@@ -409,7 +424,8 @@ def vanilla_pg(
         baseline=baseline, bound=bound, delta=delta, empirical_range=empirical_range,
         budget=budget, score_action=score_action, c=c,
     )
-    return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress)
+    return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress,
+                  stop_on_divergence)
 
 
 __all__ = ["CHECKPOINTS", "LearningRecord", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]

@@ -75,7 +75,7 @@ class Page:
 
 
 def _check_page(pg: Page, min_images: int) -> None:
-    pg.page.wait_for_selector("mjx-container", timeout=20_000)
+    pg.page.wait_for_selector("mjx-container", state="attached", timeout=20_000)
     assert pg.page.locator("mjx-container").count() > 5
     assert pg.page.locator("img").count() >= min_images
     for img in pg.page.locator("img").all():
@@ -86,7 +86,7 @@ def _check_page(pg: Page, min_images: int) -> None:
 
 def test_intro_renders(browser, book):
     pg = Page(browser, book / "book" / "intro.html")
-    pg.page.wait_for_selector("mjx-container", timeout=20_000)
+    pg.page.wait_for_selector("mjx-container", state="attached", timeout=20_000)
     assert not pg.remote and not pg.errors
 
 
@@ -114,3 +114,60 @@ def test_lqg_explorer_matches_safepg(browser, book):
     np.testing.assert_allclose(js_J, py["plots"]["J"]["series"][0]["y"], rtol=1e-9)
     for key in ("J_star", "var_reinforce", "var_gpomdp"):
         assert after["result"]["values"][key] == pytest.approx(py["values"][key], rel=1e-9)
+
+
+def _set(page, name: str, value: str) -> None:
+    el = page.locator(f'[data-param="{name}"]').first
+    if el.evaluate("e => e.tagName") == "SELECT":
+        el.select_option(value)
+    else:
+        el.fill(value)
+
+
+def test_upsilon_explorer_matches_safepg(browser, book):
+    from safepg.explorers import upsilon_explorer
+
+    pg = Page(browser, book / "book" / "adaptive_batch.html")
+    _check_page(pg, min_images=1)
+    assert pg.values()["params"] == {"delta": 0.95, "sigma": 1.0, "g": 30.0, "bound": "bernstein-er"}
+    py_explorer = upsilon_explorer()
+    seen = set()
+    for params in ({"delta": "0.5", "sigma": "1.5", "g": "12", "bound": "chebyshev-gpomdp"},
+                   {"delta": "0.25", "bound": "hoeffding-er"}, {"bound": "bernstein", "g": "45"},
+                   {"bound": "chebyshev-reinforce", "sigma": "0.7"}):
+        for k, v in params.items():
+            _set(pg.page, k, v)
+        got = pg.values()
+        expected = py_explorer.compute_py(got["params"])["values"]
+        for key, value in expected.items():
+            assert got["result"]["values"][key] == pytest.approx(value, rel=1e-9), (params, key)
+        seen.add(got["result"]["values"]["Nstar"])
+    assert len(seen) == 4  # every move changed N*
+    pg.page.locator(".safepg-explorer").first.screenshot(path=str(SHOTS / "upsilon.png"))
+    assert not pg.errors
+
+
+def test_batch_size_explorer_matches_stored_runs(browser, book):
+    from safepg.experiments import get_experiment, load_experiment
+    from safepg.explorers import batch_size_explorer
+
+    pg = Page(browser, book / "book" / "lqg1d.html")
+    _check_page(pg, min_images=4)
+    exp = get_experiment("table-5.2")
+    py = batch_size_explorer(load_experiment(exp, ROOT / "results"), exp.configs)
+    finals = set()
+    for params in ({"bound": "bernstein-er"}, {"bound": "chebyshev", "delta": "0.5"},
+                   {"estimator": "reinforce", "delta": "0.75"}, {"bound": "hoeffding", "delta": "0.95",
+                                                                 "estimator": "gpomdp"}):
+        for k, v in params.items():
+            _set(pg.page, k, v)
+        got = pg.values()
+        assert got["result"]["values"] == py.compute_py(got["params"])["values"]
+        assert got["result"]["values"]["found"]
+        finals.add(got["result"]["values"]["final_batch"])
+    assert len(finals) == 4
+    _set(pg.page, "bound", "bernstein")
+    _set(pg.page, "estimator", "reinforce")
+    assert pg.values()["result"]["values"]["found"] is False
+    pg.page.locator(".safepg-explorer").first.screenshot(path=str(SHOTS / "batch-size.png"))
+    assert not pg.errors

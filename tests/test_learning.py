@@ -154,3 +154,12 @@ def test_cli_bad_input_one_line_no_traceback(args, word):
     assert p.returncode != 0
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and word in lines[0] and "Traceback" not in p.stderr
+
+
+def test_divergence_stops_only_when_asked():
+    # b = 0 and a large fixed step: theta runs away until the gradient overflows.
+    kw = dict(batch_size=100, alpha=1e-2, baseline=False, budget=2_000_000, rng=0)
+    with pytest.raises(ValueError, match="^gradient estimate is not finite"):
+        vanilla_pg(ENV, -0.55, 1.0, **kw)
+    rec = vanilla_pg(ENV, -0.55, 1.0, stop_on_divergence=True, **kw)
+    assert rec.diverged and rec.trajectories < 2_000_000 and np.all(np.isfinite(rec.grad))
