@@ -103,7 +103,8 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, 
             return "-"
         if isinstance(v, (list, tuple)):
             return "[" + "; ".join(fmt(x, spec) for x in v) + "]"
-        return format(v, spec) if spec else str(v)
+        text = format(v, spec) if spec else str(v)
+        return text.replace("|", "\\|")  # a bare | would end the cell
 
     head = "| " + " | ".join(h for _, h, _ in columns) + " |"
     sep = "|" + "|".join("---" for _ in columns) + "|"
