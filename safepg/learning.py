@@ -231,7 +231,8 @@ def _learn(
             if n < 2:
                 break
             samples, returns = _collect(task, policy, n, rng, estimator, baseline, score_action)
-            grad = samples.mean(axis=0)
+            with np.errstate(over="ignore", invalid="ignore"):  # a non-finite mean is handled just below
+                grad = samples.mean(axis=0)
             if not np.all(np.isfinite(grad)):
                 if stop_on_divergence:
                     diverged = True
