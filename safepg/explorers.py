@@ -13,14 +13,28 @@ import numpy as np
 
 from safepg import plotting
 from safepg.analysis import by_iteration, mean_band, performance_on_grid
-from safepg.bounds import ErrorBound, bernstein, chebyshev, gpomdp_variance_factor, gradient_range_bound
-from safepg.bounds import hoeffding, reinforce_variance_factor
+from safepg.bounds import (
+    ErrorBound,
+    bernstein,
+    chebyshev,
+    gpomdp_variance_factor,
+    gradient_range_bound,
+    hoeffding,
+    reinforce_variance_factor,
+)
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.explorer import Explorer, Plot, Select, Slider
 from safepg.learning import LearningRecord
-from safepg.meta import coordinate_step, guaranteed_improvement, n_star_closed_form, n_star_search, n_zero
-from safepg.meta import penalty_constant, upsilon
+from safepg.meta import (
+    coordinate_step,
+    guaranteed_improvement,
+    n_star_closed_form,
+    n_star_search,
+    n_zero,
+    penalty_constant,
+    upsilon,
+)
 
 # ---------------------------------------------------------------------------- LQG
 _LQG_JS = r"""

@@ -9,6 +9,7 @@ the book's light and dark themes.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import matplotlib as mpl
 
@@ -25,6 +26,8 @@ BOUND_LABELS = {"chebyshev": "Chebyshev", "hoeffding": "Hoeffding", "bernstein":
 #: Colour for single-curve figures (J(theta), Upsilon).
 ACCENT = "#3b6fb6"
 MUTED = "#7f7f7f"
+#: Colour of an estimator when estimators, not bounds, are compared (REINFORCE is also dashed).
+ESTIMATOR_COLORS = {"reinforce": MUTED, "gpomdp": ACCENT}
 
 
 def use_style() -> None:
@@ -41,12 +44,38 @@ def estimator_style(estimator: str) -> dict[str, str]:
     return {"linestyle": ESTIMATOR_DASH[estimator]}
 
 
+def estimator_color(estimator: str) -> str:
+    """Colour of an estimator in figures that compare estimators (not bounds)."""
+    return ESTIMATOR_COLORS[estimator]
+
+
+def style_table() -> dict[str, Any]:
+    """Every colour, label and dash of this module as JSON-ready data, for the browser
+    explorers (``safepg.explorer``), so JavaScript and matplotlib draw alike.
+
+    Returns
+    -------
+    dict
+        ``{"accent", "muted", "estimators": {name: {"label", "color", "dash"}},
+        "bounds": {"chebyshev" | "hoeffding" | "hoeffding-er" | ...: {"label", "color"}}}``;
+        ``dash`` is true for a dashed line.
+    """
+    return {
+        "accent": ACCENT, "muted": MUTED,
+        "estimators": {e: {"label": ESTIMATOR_LABELS[e], "color": ESTIMATOR_COLORS[e],
+                           "dash": ESTIMATOR_DASH[e] != "-"} for e in ESTIMATOR_LABELS},
+        "bounds": {b + ("-er" if er else ""): {"label": bound_label(b, er), "color": c}
+                   for (b, er), c in BOUND_COLORS.items()},
+    }
+
+
 def bound_color(bound: str, empirical_range: bool = False) -> str:
     """Colour of a concentration bound (Chebyshev has no range variant)."""
     return BOUND_COLORS[(bound, bool(empirical_range) and bound != "chebyshev")]
 
 
 def bound_label(bound: str, empirical_range: bool = False) -> str:
+    """Legend label of a bound, e.g. ``"Hoeffding (e.r.)"`` with the empirical range."""
     return BOUND_LABELS[bound] + (" (e.r.)" if empirical_range else "")
 
 

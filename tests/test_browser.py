@@ -9,9 +9,6 @@ explorer's slider redraws values equal to safepg's.
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -20,34 +17,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
 SHOTS = ROOT / "_build" / "screenshots"
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
-
 pytestmark = pytest.mark.browser
 
 
-@pytest.fixture(scope="session")
-def book() -> Path:
-    if not Path(CHROMIUM).exists():
-        if os.environ.get("CI") == "true":
-            pytest.fail("chromium is not installed (make browser-deps)")
-        pytest.skip("chromium is not installed (make browser-deps)")
-    subprocess.run(["bash", "book/tools/vendor_assets.sh"], cwd=ROOT, check=True)
-    subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
-    subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
-                   stdout=subprocess.DEVNULL)
-    return HTML
-
-
-@pytest.fixture(scope="session")
-def browser(book):
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+# The fixtures `book` (the built book, once per session) and `browser` (Debian's Chromium
+# through Playwright; skipped without it, failed under CI=true) are in tests/conftest.py.
 
 
 class Page:

@@ -14,13 +14,27 @@ import subprocess
 import numpy as np
 import pytest
 
-from safepg.bounds import ErrorBound, bernstein, chebyshev, gpomdp_variance_factor, gradient_range_bound
-from safepg.bounds import hoeffding, reinforce_variance_factor
+from safepg.bounds import (
+    ErrorBound,
+    bernstein,
+    chebyshev,
+    gpomdp_variance_factor,
+    gradient_range_bound,
+    hoeffding,
+    reinforce_variance_factor,
+)
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.explorer import LIB_JS
-from safepg.meta import coordinate_step, guaranteed_improvement, n_star_closed_form, n_star_search, n_zero
-from safepg.meta import penalty_constant, upsilon
+from safepg.meta import (
+    coordinate_step,
+    guaranteed_improvement,
+    n_star_closed_form,
+    n_star_search,
+    n_zero,
+    penalty_constant,
+    upsilon,
+)
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")

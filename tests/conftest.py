@@ -1,0 +1,77 @@
+"""Shared fixtures of the browser tests: the built book and Debian's headless Chromium.
+
+``book`` builds the book once per session (notebook execution goes through the
+Jupyter Book cache, so a rebuild with unchanged notebooks takes seconds);
+``browser`` launches ``/usr/bin/chromium`` through Playwright, never a downloaded
+browser. Without Chromium (or Playwright) the browser tests are skipped, except under
+``CI=true``, where they fail: CI must not pass by skipping them (``make browser-deps``
+installs Chromium). A test asks for ``browser`` before ``book``, so a skipped test does
+not build the book first. Only one Playwright instance may run per process: every
+browser test shares this one.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HTML = ROOT / "_build" / "html"
+SHOTS = ROOT / "_build" / "screenshots"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+
+def in_ci() -> bool:
+    """True when the environment says this is a CI run (``CI=true``)."""
+    return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
+
+
+def skip_or_fail(reason: str) -> None:
+    """Skip the test, or fail it under CI."""
+    if in_ci():
+        pytest.fail(f"{reason} (CI=true: browser tests must run)")
+    pytest.skip(reason)
+
+
+def build_book() -> Path:
+    """Fetch the vendored assets and build the book with warnings as errors.
+
+    Returns
+    -------
+    Path
+        ``_build/html``.
+    """
+    subprocess.run(["bash", "book/tools/vendor_assets.sh"], cwd=ROOT, check=True)
+    subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
+    subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
+                   stdout=subprocess.DEVNULL)
+    return HTML
+
+
+@pytest.fixture(scope="session")
+def book() -> Path:
+    """The book, built once per test session; ``_build/html``."""
+    return build_book()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    """Debian's Chromium, headless, driven by Playwright (a ``Browser``)."""
+    if not Path(CHROMIUM).exists():
+        skip_or_fail(f"{CHROMIUM} is missing: run `make browser-deps` (apt-get install chromium)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        skip_or_fail("playwright (python) is not installed: run `make setup`")
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield browser
+        browser.close()
