@@ -1,0 +1,426 @@
+r"""Continuous-action cart-pole (thesis Section 5.3), batched, plus a gymnasium environment.
+
+State :math:`s = [x, \dot x, \beta, \dot\beta]` (cart position in m, cart velocity in m/s,
+pole angle from the vertical in rad, angular velocity in rad/s); the action is the
+horizontal force on the cart in N, clipped to [-10, 10] before it is applied. The policy
+is linear Gaussian, :math:`a \sim \mathcal N(\theta^\top s, \sigma^2)`, so the features are
+the state itself.
+
+Physics: the frictionless cart-pole of Barto, Sutton and Anderson (1983) with the
+equations of motion of Florian (2007, "Correct equations for the dynamics of the
+cart-pole system"), integrated with the explicit Euler scheme that gymnasium's
+``CartPoleEnv`` uses (``kinematics_integrator = "euler"``: positions advance with the
+*old* velocities). The pole is a uniform rod hinged at its lower end, so its centre of
+mass sits at half its length and its moment of inertia about the centre is
+:math:`m (2l)^2 / 12`, which gives the 4/3 factor below.
+
+.. math::
+    \ddot\beta = \frac{g\sin\beta - \cos\beta\,\dfrac{F + m l\dot\beta^2\sin\beta}{M}}
+                      {l\left(\tfrac43 - \dfrac{m\cos^2\beta}{M}\right)}, \qquad
+    \ddot x = \frac{F + m l (\dot\beta^2\sin\beta - \ddot\beta\cos\beta)}{M}
+
+with :math:`l` the *half* pole length, :math:`m` the pole mass and :math:`M = m + m_c`.
+
+What the thesis states and what is ours (every choice is a field of :class:`CartPole`):
+
+- stated: cart 1 kg, pole 0.1 kg, pole 1 m long, force in [-10, 10] N, reward 1 per step,
+  H = 200, termination when :math:`|\beta| > 41.8^\circ` or :math:`|x| > 2.4` m, initial
+  state "in a small neighbourhood of 0", sigma = 1, theta_0 = 0, and (for the adaptation
+  experiment) the pole length doubled with its mass kept.
+- ours: gravity 9.8, time step 0.02 s, Euler integration, initial state uniform in
+  [-0.05, 0.05]^4 (all gymnasium's), the discount gamma = 0.99 and the feature bound
+  M_phi = 10 (see :class:`CartPole`).
+
+"1 m long" is the whole pole: gymnasium's ``length = 0.5`` is documented there as
+"actually half the pole's length", and the original pole.c of Barto et al. uses the same
+0.5 m half-length, i.e. a 1 m pole. So the thesis's pole *is* gymnasium's default pole, and
+doubling it gives gymnasium ``length = 1.0``. ``pole_length`` below is always the full length.
+
+41.8 degrees is not gymnasium's (or gym's) termination angle, which is 12 degrees. Most
+likely it comes from the "Pole Angle -41.8 deg ... 41.8 deg" row of the observation table
+in old gym's CartPole-v0 documentation, which mislabels the observation *box* half-width,
+0.418 rad (= 2 x 12 degrees = 24 degrees), as degrees. The thesis prints 41.8 degrees, so
+that is the default; ``angle_threshold_deg=12`` gives gym's task.
+
+Rewards and the mask: at step t the episode is alive if s_t is inside the thresholds;
+then the agent acts, gets r_t = 1 and the system moves to s_{t+1}. If s_{t+1} is outside,
+steps t+1, ..., H-1 are dead (mask False, reward 0, features and actions 0). So, as in
+gymnasium, the step into the failing state is still rewarded and the undiscounted return
+is the episode length (at most H = 200).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from safepg._rng import RNGLike, as_generator
+from safepg.policies import LinearGaussianPolicy, _check_sigma
+from safepg.trajectories import Trajectories
+
+#: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
+ENV_ID = "safepg/ContinuousCartPole-v0"
+
+# Defaults shared by the pure step function, the batched task and the gymnasium env.
+_CART_MASS = 1.0  # kg (thesis)
+_POLE_MASS = 0.1  # kg (thesis)
+_POLE_LENGTH = 1.0  # m, whole pole (thesis "1m long" = gymnasium half-length 0.5)
+_GRAVITY = 9.8  # m/s^2, gymnasium's value (the thesis does not state one)
+_TAU = 0.02  # s, gymnasium's time step (the thesis does not state one)
+
+
+def step_dynamics(
+    state: np.ndarray,
+    force: np.ndarray | float,
+    pole_length: float = _POLE_LENGTH,
+    *,
+    cart_mass: float = _CART_MASS,
+    pole_mass: float = _POLE_MASS,
+    gravity: float = _GRAVITY,
+    tau: float = _TAU,
+) -> np.ndarray:
+    r"""One explicit-Euler step of the cart-pole, vectorised over leading axes.
+
+    Parameters
+    ----------
+    state : ndarray, shape (..., 4)
+        States [x, x_dot, beta, beta_dot] (beta in radians).
+    force : float or ndarray, shape (...)
+        Force applied to the cart in N (already clipped: no clipping happens here).
+    pole_length : float
+        *Whole* pole length in m (gymnasium's ``length`` is half of it).
+    cart_mass, pole_mass, gravity, tau : float
+        Cart and pole masses (kg), gravitational acceleration (m/s^2), time step (s).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        The next states. Positions advance with the old velocities (explicit Euler, as
+        gymnasium's ``CartPoleEnv`` with ``kinematics_integrator="euler"``).
+    """
+    s = np.asarray(state, dtype=float)
+    x, x_dot, beta, beta_dot = s[..., 0], s[..., 1], s[..., 2], s[..., 3]
+    half = 0.5 * pole_length  # the equations use the distance hinge -> centre of mass
+    total = cart_mass + pole_mass
+    sin, cos = np.sin(beta), np.cos(beta)
+    # Force on the cart plus the centrifugal pull of the pole, per unit of total mass.
+    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
+    x_acc = push - pole_mass * half * beta_acc * cos / total
+    out = np.empty(np.broadcast_shapes(s.shape, np.shape(force) + (4,)))
+    out[..., 0] = x + tau * x_dot
+    out[..., 1] = x_dot + tau * x_acc
+    out[..., 2] = beta + tau * beta_dot
+    out[..., 3] = beta_dot + tau * beta_acc
+    return out
+
+
+@dataclass(frozen=True)
+class CartPole:
+    r"""The continuous cart-pole task of Section 5.3, simulated N carts at a time.
+
+    Parameters
+    ----------
+    pole_length : float
+        Whole pole length in m: 1.0 in the thesis, 2.0 after "doubling the length of the
+        pole, keeping its mass constant" (gymnasium ``length`` 0.5 and 1.0).
+    gamma : float
+        Discount factor in (0, 1]. Ours: 0.99. The bounds of Chapter 4 need gamma < 1
+        (the penalty constant has (1 - gamma)^-2), and 0.99 is the usual choice for a
+        200-step task (the horizon 1 / (1 - gamma) = 100 steps spans most of the episode).
+        The thesis's reported performances (195, 193.12) exceed the largest 0.99-discounted
+        return, (1 - 0.99^200) / 0.01 = 86.6, so they are *undiscounted* returns: use
+        :meth:`undiscounted_returns` (the episode length) to compare with them.
+    horizon : int
+        Maximum episode length H (thesis: 200).
+    angle_threshold_deg : float
+        Termination angle in degrees (thesis: 41.8; gymnasium: 12).
+    x_threshold : float
+        Termination cart position in m (thesis and gymnasium: 2.4).
+    action_bound : float
+        Force limit A-bar in N; the Gaussian action is clipped to [-A-bar, A-bar] (thesis: 10).
+    feature_bound : float
+        M_phi, a bound on |s_i| over alive states. Ours: 10. x and beta are bounded by the
+        thresholds (2.4 m, 0.7295 rad), but the velocities are not bounded a priori. The
+        largest |x_dot| and |beta_dot| we could reach in an alive state within 200 steps,
+        searching with the cross-entropy method over saturated linear feedback laws
+        (gain, bias, initial state) and over open-loop force sequences, were 9.53 m/s and
+        6.13 rad/s for the 1 m pole and 9.57 m/s and 4.25 rad/s for the 2 m pole (the
+        theta = 0, sigma = 1 policy stays below 1 m/s and 3 rad/s). 10 is that empirical
+        maximum rounded up; it is a measured, not a proven, bound.
+    cart_mass, pole_mass : float
+        Masses in kg (thesis: 1 and 0.1).
+    gravity : float
+        m/s^2. Ours (unstated in the thesis): gymnasium's 9.8.
+    tau : float
+        Integration time step in s. Ours (unstated): gymnasium's 0.02.
+    init_bound : float
+        The initial state is uniform in [-init_bound, init_bound]^4. The thesis says "a
+        small neighborhood of 0"; ours: gymnasium's 0.05.
+    """
+
+    pole_length: float = _POLE_LENGTH
+    gamma: float = 0.99
+    horizon: int = 200
+    angle_threshold_deg: float = 41.8
+    x_threshold: float = 2.4
+    action_bound: float = 10.0
+    feature_bound: float = 10.0
+    cart_mass: float = _CART_MASS
+    pole_mass: float = _POLE_MASS
+    gravity: float = _GRAVITY
+    tau: float = _TAU
+    init_bound: float = 0.05
+
+    #: State and action dimensions (the features are the state: d_phi = 4).
+    state_dim: ClassVar[int] = 4
+    action_dim: ClassVar[int] = 1
+    #: R = max |r|: the reward is 1 while alive and 0 afterwards.
+    reward_bound: ClassVar[float] = 1.0
+
+    def __post_init__(self) -> None:
+        if not 0 < self.gamma <= 1:
+            raise ValueError(f"gamma must be in (0, 1], got {self.gamma}")
+        if int(self.horizon) != self.horizon or self.horizon < 1:
+            raise ValueError(f"horizon must be a positive integer, got {self.horizon}")
+        for name in ("pole_length", "angle_threshold_deg", "x_threshold", "action_bound", "feature_bound",
+                     "cart_mass", "pole_mass", "gravity", "tau", "init_bound"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v}")
+        if self.init_bound >= min(self.x_threshold, self.angle_threshold):
+            raise ValueError(f"init_bound must leave the initial state alive, got {self.init_bound}")
+
+    # ------------------------------------------------------------------ settings
+    @classmethod
+    def thesis(cls, **overrides: Any) -> CartPole:
+        """The task of Section 5.3 with our choices for the unstated constants."""
+        return cls(**overrides)
+
+    @classmethod
+    def thesis_doubled(cls, **overrides: Any) -> CartPole:
+        """The modified task of Section 5.3: pole length doubled (2 m), mass unchanged."""
+        return cls(**{"pole_length": 2 * _POLE_LENGTH, **overrides})
+
+    # ------------------------------------------------------------ bound constants
+    @property
+    def angle_threshold(self) -> float:
+        """Termination angle in radians (41.8 degrees = 0.72955 rad by default)."""
+        return math.radians(self.angle_threshold_deg)
+
+    @property
+    def action_volume(self) -> float:
+        """|A|: length of the force interval, 2 A-bar = 20."""
+        return float(2 * self.action_bound)
+
+    # ------------------------------------------------------------------ dynamics
+    def step(self, state: np.ndarray, force: np.ndarray | float) -> np.ndarray:
+        """:func:`step_dynamics` with this task's physical constants (force not clipped)."""
+        return step_dynamics(state, force, self.pole_length, cart_mass=self.cart_mass, pole_mass=self.pole_mass,
+                             gravity=self.gravity, tau=self.tau)
+
+    def alive(self, state: np.ndarray) -> np.ndarray:
+        """Whether states (..., 4) are inside the thresholds (|x| <= 2.4, |beta| <= 41.8 deg)."""
+        s = np.asarray(state, dtype=float)
+        return (np.abs(s[..., 0]) <= self.x_threshold) & (np.abs(s[..., 2]) <= self.angle_threshold)
+
+    # ----------------------------------------------------------------- simulator
+    def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
+        """Simulate ``n`` episodes of at most H steps under ``policy`` at once.
+
+        Same signature as :meth:`safepg.envs.LQG.simulate` (the learning loops call it);
+        :meth:`simulate_gain` takes the gain and sigma instead of a policy.
+
+        Random numbers are drawn in a fixed order: the (n, 4) initial states, then one
+        (n, H, 1) array of standard normals, so a seed fixes the batch bit for bit.
+        The loop runs over time steps only; each step is whole-array work on n carts.
+
+        Parameters
+        ----------
+        policy : LinearGaussianPolicy
+            Policy with a (1, 4) gain: a = K s + sigma * noise.
+        n : int
+            Number of trajectories (>= 1).
+        rng : Generator, int or None
+            Random source (see :func:`safepg._rng.as_generator`).
+
+        Returns
+        -------
+        Trajectories
+            features = states, actions_raw = sampled forces, actions = clipped forces,
+            rewards = 1 while alive, mask = alive; zeros at dead steps.
+        """
+        if not isinstance(policy, LinearGaussianPolicy):
+            raise ValueError(f"policy must be a LinearGaussianPolicy, got {type(policy).__name__}")
+        if policy.gain.shape != (self.action_dim, self.state_dim):
+            raise ValueError(f"policy must have a (1, 4) gain for the cart-pole, got {policy.gain.shape}")
+        integral = (isinstance(n, (int, np.integer, float)) and not isinstance(n, bool)
+                    and math.isfinite(n) and n == int(n))
+        if not (integral and n >= 1):
+            raise ValueError(f"n must be a positive integer, got {n!r}")
+        n = int(n)
+        rng = as_generator(rng)
+        H, b = self.horizon, self.action_bound
+        K = policy.gain[0]
+        std = float(policy.cov_chol[0, 0])
+
+        s = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
+        noise = rng.standard_normal((n, H, 1))
+
+        # Time-major buffers, so step t writes one contiguous block; transposed once at the end.
+        feats = np.zeros((H, n, self.state_dim))
+        raw = np.zeros((H, n))
+        alive_t = np.zeros((H, n), dtype=bool)
+        alive = np.ones(n, dtype=bool)  # s_0 is inside the thresholds (init_bound is checked)
+        for t in range(H):
+            if not alive.any():  # every episode has ended: the rest stays zero
+                break
+            alive_t[t] = alive
+            feats[t] = s
+            raw[t] = s @ K + std * noise[:, t, 0]
+            # Dead carts are frozen, not integrated: a fallen pole under linear feedback can
+            # grow without bound (overflow warnings) and its state is never used again.
+            s = np.where(alive[:, None], self.step(s, np.clip(raw[t], -b, b)), s)
+            alive &= self.alive(s)
+        mask = np.ascontiguousarray(alive_t.T)
+        # Zero the dead steps (scores there must vanish, nothing stale should leak out).
+        # The frozen states are finite, so multiplying by the mask gives exact zeros.
+        feats = np.ascontiguousarray(feats.transpose(1, 0, 2)) * mask[:, :, None]
+        raw = np.ascontiguousarray(raw.T * mask)[:, :, None]
+        acts = np.clip(raw, -b, b)  # the forces applied (clip(0) = 0 at dead steps)
+        return Trajectories(feats, raw, acts, mask.astype(float), mask, self.gamma)
+
+    def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
+                      rng: RNGLike = None) -> Trajectories:
+        """:meth:`simulate` for the policy N(gain @ s, sigma^2).
+
+        Parameters
+        ----------
+        gain : array_like, shape (1, 4) or (4,)
+            Policy gain K (theta = K.ravel()).
+        sigma : float, array_like (1,) or (1, 1)
+            Action standard deviation, or a (1, 1) covariance.
+        n, rng
+            As in :meth:`simulate`.
+        """
+        K = np.asarray(gain, dtype=float)
+        if K.shape == (self.state_dim,):
+            K = K[None, :]
+        if K.shape != (self.action_dim, self.state_dim):
+            raise ValueError(f"gain must have shape (1, 4) or (4,), got {np.shape(gain)}")
+        if not np.all(np.isfinite(K)):
+            raise ValueError(f"gain must be finite, got {K.ravel()}")
+        _check_sigma(sigma, self.action_dim)  # raises "sigma ..." errors before the policy does
+        return self.simulate(LinearGaussianPolicy(K, sigma), n, rng)
+
+    # ------------------------------------------------------------------- metrics
+    @staticmethod
+    def undiscounted_returns(batch: Trajectories) -> np.ndarray:
+        """Sum of rewards per trajectory = episode length, shape (N,).
+
+        This is the performance the thesis reports for the cart-pole (at most H = 200).
+        """
+        return batch.rewards.sum(axis=1)
+
+
+# ---------------------------------------------------------------------- gymnasium
+# gymnasium is an optional dependency (``pip install safepg[gym]``): without it the
+# batched task above works, ContinuousCartPoleEnv is absent and register_envs does nothing.
+try:
+    import gymnasium as _gym
+    from gymnasium import spaces as _spaces
+except ImportError:  # pragma: no cover - exercised only without gymnasium
+    _gym = None
+
+
+if _gym is not None:
+
+    class ContinuousCartPoleEnv(_gym.Env):
+        """Single cart-pole as a gymnasium environment, the same task as :class:`CartPole`.
+
+        The action is a force in N, clipped to [-10, 10] (the action space) before it is
+        applied, like the Gaussian samples in :meth:`CartPole.simulate`. Reward 1 per step
+        taken from an alive state (the step into the failing state included); the episode
+        terminates when |x| > 2.4 or |beta| > 41.8 deg and is truncated after ``horizon``
+        steps (internally, so the env behaves the same with or without ``gymnasium.make``).
+        Stepping after the end returns reward 0 and the same flags.
+
+        Parameters
+        ----------
+        render_mode : None
+            Rendering is not implemented.
+        **task : Any
+            Fields of :class:`CartPole` (e.g. ``pole_length=2.0``).
+
+        Notes
+        -----
+        ``reset(options={"state": s0})`` starts from a given state instead of a uniform
+        draw (used to replay the batched simulator's initial states).
+        """
+
+        metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+
+        def __init__(self, render_mode: str | None = None, **task: Any) -> None:
+            if render_mode is not None:
+                raise ValueError(f"render_mode must be None (rendering is not implemented), got {render_mode!r}")
+            self.render_mode = render_mode
+            self.task = CartPole(**task)
+            b = self.task.action_bound
+            self.action_space = _spaces.Box(-b, b, shape=(1,), dtype=np.float64)
+            # The state leaves the alive region on the terminating step, by an amount that
+            # depends on the (unbounded) velocities: no finite box is guaranteed.
+            self.observation_space = _spaces.Box(-np.inf, np.inf, shape=(4,), dtype=np.float64)
+            self.state: np.ndarray | None = None
+            self._t = 0  # steps taken in the current episode
+            self._terminated = False
+            self._truncated = False
+
+        def reset(self, *, seed: int | None = None,
+                  options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+            super().reset(seed=seed)
+            if options is not None and "state" in options:
+                s0 = np.array(options["state"], dtype=float)
+                if s0.shape != (4,) or not np.all(np.isfinite(s0)):
+                    raise ValueError(f"options['state'] must be 4 finite numbers, got {options['state']!r}")
+            else:
+                c = self.task.init_bound
+                s0 = self.np_random.uniform(-c, c, size=4)
+            self.state = s0
+            self._t = 0
+            self._terminated = not bool(self.task.alive(s0))  # only possible with options["state"]
+            self._truncated = False
+            return s0.copy(), {}
+
+        def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+            if self.state is None:
+                raise RuntimeError("call reset() before step()")
+            a = np.asarray(action, dtype=float).reshape(-1)
+            if a.shape != (1,) or not np.isfinite(a[0]):
+                raise ValueError(f"action must be one finite force, got {action!r}")
+            if self._terminated or self._truncated:  # the episode is over: nothing moves, no reward
+                return self.state.copy(), 0.0, self._terminated, self._truncated, {}
+            u = float(np.clip(a[0], -self.task.action_bound, self.task.action_bound))
+            # The same vectorised step as the batched simulator, on a batch of one.
+            self.state = self.task.step(self.state[None, :], u)[0]
+            self._t += 1
+            self._terminated = not bool(self.task.alive(self.state))
+            self._truncated = not self._terminated and self._t >= self.task.horizon
+            return self.state.copy(), 1.0, self._terminated, self._truncated, {}
+
+    def register_envs() -> None:
+        """Register :class:`ContinuousCartPoleEnv` as ``"safepg/ContinuousCartPole-v0"``.
+
+        Idempotent. Truncation at H happens inside the env, so no ``max_episode_steps``.
+        """
+        if ENV_ID not in _gym.registry:
+            _gym.register(id=ENV_ID, entry_point="safepg.envs.cartpole:ContinuousCartPoleEnv")
+
+    register_envs()
+
+else:  # pragma: no cover
+
+    def register_envs() -> None:
+        """No-op without gymnasium (an optional dependency)."""
