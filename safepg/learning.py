@@ -56,7 +56,8 @@ class LearningRecord:
     J : float array (I + 1,)
         Closed-form expected performance J(theta[i]) (NaN if the task has none).
     J_hat : float array (I,)
-        Measured performance: mean discounted return of batch i.
+        Measured performance: mean return of batch i (discounted; for a task with
+        ``measured_returns``, such as the cart-pole, the return that defines).
     grad : float array (I, m)
         Gradient estimate of batch i.
     eps : float array (I,)
@@ -71,6 +72,9 @@ class LearningRecord:
     diverged : bool
         The run stopped because the gradient estimate overflowed (theta diverged under a
         fixed step); only with ``stop_on_divergence=True``.
+    reached_target : bool
+        The run stopped because a batch's mean return reached ``target_return``; that
+        last batch made no update, so ``theta_final`` is the policy that reached it.
     """
 
     batch_size: np.ndarray
@@ -85,6 +89,7 @@ class LearningRecord:
     config: dict[str, Any] = field(default_factory=dict)
     interrupted: bool = False
     diverged: bool = False
+    reached_target: bool = False
 
     @property
     def iterations(self) -> int:
@@ -144,12 +149,14 @@ class LearningRecord:
             "batch_sizes": self.batch_size.tolist(),
             "interrupted": self.interrupted,
             "diverged": self.diverged,
+            "reached_target": self.reached_target,
         }
 
     def save(self, path: str | Path) -> None:
         """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
         arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
-        meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged})
+        meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged,
+                           "reached_target": self.reached_target})
         np.savez_compressed(path, meta=np.array(meta), **arrays)
 
     @classmethod
@@ -158,7 +165,7 @@ class LearningRecord:
             meta = json.loads(str(z["meta"]))
             arrays = {k: z[k] for k in z.files if k != "meta"}
         return cls(**arrays, config=meta["config"], interrupted=meta["interrupted"],
-                   diverged=meta.get("diverged", False))
+                   diverged=meta.get("diverged", False), reached_target=meta.get("reached_target", False))
 
 
 @dataclass(frozen=True)
@@ -174,27 +181,35 @@ class _Update:
 UpdateRule = Callable[[np.ndarray, int], _Update]
 
 
-def _closed_form(task: Task, sigma: float) -> Callable[[np.ndarray], float]:
+def _closed_form(task: Task, thetas: np.ndarray, sigma: float) -> np.ndarray:
+    """J(theta_i) for every row of ``thetas``; NaN for a task without a closed form."""
+    batched = getattr(task, "performance_batch", None)
+    if batched is not None:
+        return np.asarray(batched(thetas, sigma), dtype=float)
     perf = getattr(task, "performance", None)
     if perf is None:
-        return lambda theta: float("nan")
-    return lambda theta: perf(theta, sigma)
+        return np.full(len(thetas), np.nan)
+    return np.array([perf(theta, sigma) for theta in thetas], dtype=float)
 
 
 def _collect(
     task: Task, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator,
     estimator: Estimator, baseline: bool, score_action: ScoreAction,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gradient samples (n, m) and discounted returns (n,) of a fresh batch.
+    """Gradient samples (n, m) and measured returns (n,) of a fresh batch.
 
-    Uses the task's fused ``gradient_batch`` when it has one (the LQG does), else
-    simulates the batch and applies :func:`safepg.estimators.gradient_samples`.
+    Uses the task's fused ``gradient_batch`` when it has one (the LQG and the cart-pole
+    do), else simulates the batch and applies :func:`safepg.estimators.gradient_samples`.
+    The measured return is the task's ``measured_returns(batch)`` if it defines one (the
+    cart-pole: the undiscounted episode length the thesis reports), else the discounted
+    return.
     """
     fused = getattr(task, "gradient_batch", None)
     if fused is not None:
         return fused(policy, n, rng, estimator, baseline, score_action)
     batch = task.simulate(policy, n, rng)
-    return gradient_samples(policy, batch, estimator, baseline, score_action), batch.discounted_returns()
+    measured = getattr(task, "measured_returns", Trajectories.discounted_returns)
+    return gradient_samples(policy, batch, estimator, baseline, score_action), measured(batch)
 
 
 def _check_budget(budget: int, n_first: int) -> None:
@@ -215,14 +230,14 @@ def _learn(
     config: dict[str, Any],
     progress: bool,
     stop_on_divergence: bool = False,
+    target_return: float | None = None,
 ) -> LearningRecord:
     rng = as_generator(rng)
-    J = _closed_form(task, policy.sigma)
     theta = policy.theta
-    thetas, Js = [theta.copy()], [J(theta)]
+    thetas = [theta.copy()]
     rows: dict[str, list[Any]] = {k: [] for k in ("batch_size", "alpha", "coordinate", "J_hat", "grad", "eps", "safe")}
     used, n = 0, n_first
-    interrupted = diverged = False
+    interrupted = diverged = reached = False
     bar = tqdm(total=budget, unit="traj", disable=not progress, leave=False, dynamic_ncols=True)
     try:
         while True:
@@ -238,17 +253,24 @@ def _learn(
                     diverged = True
                     break
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
-            up = rule(samples, n)
+            J_hat = float(returns.mean())
+            if target_return is not None and J_hat >= target_return:
+                # The policy that produced this batch is the result: record the batch, keep theta.
+                up = _Update(np.zeros_like(grad), 0.0, -1, 0.0, True, n)
+                reached = True
+            else:
+                up = rule(samples, n)
             theta = theta + up.delta_theta
             policy = policy.with_theta(theta)
             used += n
             for k, v in (("batch_size", n), ("alpha", up.alpha), ("coordinate", up.coordinate),
-                         ("J_hat", float(returns.mean())), ("grad", grad),
+                         ("J_hat", J_hat), ("grad", grad),
                          ("eps", up.eps), ("safe", up.safe)):
                 rows[k].append(v)
             thetas.append(theta.copy())
-            Js.append(J(theta))
             bar.update(n)
+            if reached:
+                break
             n = up.next_n
     except KeyboardInterrupt:
         interrupted = True
@@ -256,12 +278,13 @@ def _learn(
     finally:
         bar.close()
     m = theta.size
+    theta_rows = np.asarray(thetas, dtype=float).reshape(-1, m)
     return LearningRecord(
         batch_size=np.asarray(rows["batch_size"], dtype=np.int64),
         alpha=np.asarray(rows["alpha"], dtype=float),
         coordinate=np.asarray(rows["coordinate"], dtype=np.int64),
-        theta=np.asarray(thetas, dtype=float).reshape(-1, m),
-        J=np.asarray(Js, dtype=float),
+        theta=theta_rows,
+        J=_closed_form(task, theta_rows, policy.sigma),
         J_hat=np.asarray(rows["J_hat"], dtype=float),
         grad=np.asarray(rows["grad"], dtype=float).reshape(-1, m),
         eps=np.asarray(rows["eps"], dtype=float),
@@ -269,6 +292,7 @@ def _learn(
         config=config,
         interrupted=interrupted,
         diverged=diverged,
+        reached_target=reached,
     )
 
 
@@ -378,6 +402,7 @@ def vanilla_pg(
     rng: RNGLike = None,
     progress: bool = False,
     stop_on_divergence: bool = False,
+    target_return: float | None = None,
 ) -> LearningRecord:
     r"""Policy gradient with a fixed batch size.
 
@@ -388,6 +413,11 @@ def vanilla_pg(
     as compared in Section 5.2.1 (Figures 5.5-5.6). A fixed step can make theta diverge
     until the gradient overflows: with ``stop_on_divergence=True`` the run then ends and
     the record says so (``diverged``), instead of raising.
+
+    ``target_return`` stops the run at the first batch whose mean measured return reaches
+    it, without updating (``reached_target``): the protocol that learns the cart-pole
+    baseline policy of Section 5.3 ("we stop once an average performance of 195 over the
+    batch is achieved"). ``budget`` then caps the search.
     """
     if int(batch_size) != batch_size or batch_size < 2:
         raise ValueError(f"batch_size must be an integer >= 2, got {batch_size}")
@@ -397,6 +427,8 @@ def vanilla_pg(
         raise ValueError(f"step must be 'scalar' or 'coordinate', got {step!r}")
     if alpha is None:
         check_delta(delta)
+    if target_return is not None and not np.isfinite(target_return):
+        raise ValueError(f"target_return must be finite or None, got {target_return}")
     _check_budget(budget, batch_size)
     policy = _initial_policy(task, theta0, sigma)
     constants = TaskConstants.from_task(task, policy.sigma)
@@ -423,10 +455,10 @@ def vanilla_pg(
         algorithm="vanilla", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
         sigma=sigma, batch_size=batch_size, alpha=alpha, step=step, estimator=estimator,
         baseline=baseline, bound=bound, delta=delta, empirical_range=empirical_range,
-        budget=budget, score_action=score_action, c=c,
+        budget=budget, score_action=score_action, c=c, target_return=target_return,
     )
     return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress,
-                  stop_on_divergence)
+                  stop_on_divergence, target_return)
 
 
 __all__ = ["CHECKPOINTS", "LearningRecord", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]

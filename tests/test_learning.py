@@ -12,6 +12,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
+from safepg.policies import LinearGaussianPolicy
 
 ENV = LQG.thesis_1d()
 ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe")
@@ -163,3 +164,35 @@ def test_divergence_stops_only_when_asked():
         vanilla_pg(ENV, -0.55, 1.0, **kw)
     rec = vanilla_pg(ENV, -0.55, 1.0, stop_on_divergence=True, **kw)
     assert rec.diverged and rec.trajectories < 2_000_000 and np.all(np.isfinite(rec.grad))
+
+
+def test_target_return_stops_at_the_first_batch_that_reaches_it():
+    kw = dict(batch_size=200, alpha=1e-3, budget=200 * 40, rng=4)
+    full = vanilla_pg(ENV, -0.1, 1.0, **kw)
+    target = float(np.sort(full.J_hat)[-5])  # reached, but not at the first batch
+    first = int(np.argmax(full.J_hat >= target))
+    rec = vanilla_pg(ENV, -0.1, 1.0, target_return=target, **kw)
+    assert rec.reached_target and not full.reached_target
+    assert rec.iterations == first + 1
+    np.testing.assert_array_equal(rec.J_hat, full.J_hat[: first + 1])
+    # The batch that reached the target makes no update: the result is the policy that reached it.
+    assert rec.alpha[-1] == 0 and np.array_equal(rec.theta[-1], rec.theta[-2])
+    np.testing.assert_array_equal(rec.theta[:-1], full.theta[: first + 1])
+    with pytest.raises(ValueError, match="target_return"):
+        vanilla_pg(ENV, batch_size=100, budget=1000, target_return=float("nan"))
+
+
+def test_measured_returns_hook_sets_J_hat():
+    class Undiscounted(LQG):
+        """An LQG reporting undiscounted returns, through the hook the cart-pole uses."""
+
+        gradient_batch = None  # take the simulate + gradient_samples path
+
+        def measured_returns(self, batch):
+            return batch.rewards.sum(axis=1)
+
+    env = Undiscounted(dim=1, gamma=0.9, horizon=20)
+    rec = vanilla_pg(env, -0.3, 1.0, batch_size=300, alpha=1e-3, budget=600, rng=1)
+    batch = env.simulate(LinearGaussianPolicy(np.array([[-0.3]]), 1.0), 300, np.random.default_rng(1))
+    assert rec.J_hat[0] == pytest.approx(batch.rewards.sum(axis=1).mean(), rel=1e-12)
+    assert rec.J_hat[0] != pytest.approx(batch.discounted_returns().mean(), rel=1e-3)

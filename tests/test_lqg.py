@@ -139,3 +139,22 @@ def test_bad_theta_raises():
         env.performance(-0.2, 0.0)
     with pytest.raises(ValueError, match="^theta"):
         env.simulate(LinearGaussianPolicy(np.zeros((2, 2)), 1.0), 10, 0)
+
+
+@pytest.mark.parametrize("env", [LQG.thesis_1d(), LQG.thesis_2d(gamma=0.9), ENV2], ids=["1d", "2d", "2d-coupled"])
+def test_performance_batch_equals_performance(env):
+    # Half of these gains are unstable: the batched solve must give -inf exactly there.
+    thetas = np.random.default_rng(3).uniform(-1.6, 0.6, size=(200, env.dim**2))
+    one_by_one = np.array([env.performance(t, 0.7) for t in thetas])
+    batched = env.performance_batch(thetas, 0.7)
+    assert 0.2 < np.isfinite(one_by_one).mean() < 0.9
+    assert np.array_equal(np.isinf(batched), np.isinf(one_by_one))
+    ok = np.isfinite(one_by_one)
+    np.testing.assert_allclose(batched[ok], one_by_one[ok], rtol=1e-12)
+
+
+def test_performance_batch_bad_shape_names_thetas():
+    with pytest.raises(ValueError, match="thetas"):
+        LQG.thesis_2d().performance_batch(np.zeros((3, 3)), 1.0)
+    with pytest.raises(ValueError, match="thetas"):
+        LQG.thesis_2d().performance_batch(np.full((1, 4), np.nan), 1.0)

@@ -208,6 +208,43 @@ class LQG:
         noise = 0.5 * np.trace(R @ S) + self.gamma * np.trace(B.T @ P @ B @ S)
         return float(-np.trace(P @ self.initial_second_moment()) - noise / (1 - self.gamma))
 
+    def performance_batch(self, thetas: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
+        r""":meth:`performance` for many parameters at once, shape (I,).
+
+        The learning loops record J(theta_i) at every iteration; a run with a small fixed
+        batch has 10^5 iterations, so the Lyapunov equations are solved together as one
+        batched linear system, :math:`(I - \gamma F^\top\otimes F^\top)\,\mathrm{vec}(P)
+        = \mathrm{vec}(\tfrac12(Q + K^\top R K))` with :math:`F = A + BK`.
+
+        Parameters
+        ----------
+        thetas : ndarray, shape (I, m * m)
+            One flattened gain per row.
+        sigma : float or ndarray
+            Policy standard deviation (or covariance), as in :meth:`performance`.
+        """
+        d = self.dim
+        T = np.asarray(thetas, dtype=float)
+        if T.ndim != 2 or T.shape[1] != d * d:
+            raise ValueError(f"thetas must have shape (I, {d * d}), got {T.shape}")
+        if not np.all(np.isfinite(T)):
+            raise ValueError("thetas must be finite")
+        A, B, Q, R = self._mats
+        S = _check_sigma(sigma, d)
+        K = T.reshape(-1, d, d)
+        F = A + B @ K
+        radius = np.abs(F[:, 0, 0]) if d == 1 else np.max(np.abs(np.linalg.eigvals(F)), axis=1)
+        stable = radius * np.sqrt(self.gamma) < 1
+        F = np.where(stable[:, None, None], F, 0.0)  # keeps the solve regular; the rows are -inf below
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's gains; their rows are -inf
+            M = np.where(stable[:, None, None], 0.5 * (Q + np.swapaxes(K, 1, 2) @ R @ K), 0.0)
+        Ft = np.swapaxes(F, 1, 2)
+        kron = np.einsum("iab,icd->iacbd", Ft, Ft).reshape(-1, d * d, d * d)
+        P = np.linalg.solve(np.eye(d * d) - self.gamma * kron, M.reshape(-1, d * d, 1)).reshape(-1, d, d)
+        noise = 0.5 * np.trace(R @ S) + self.gamma * np.einsum("ab,iac,cb->i", B, P, B @ S)
+        J = -np.einsum("iab,ba->i", P, self.initial_second_moment()) - noise / (1 - self.gamma)
+        return np.where(stable, J, -np.inf)
+
     def gradient(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> np.ndarray:
         r"""Closed-form policy gradient :math:`\nabla_\theta J`, flattened like theta.
 
