@@ -253,15 +253,7 @@ class CartPole:
             features = states, actions_raw = sampled forces, actions = clipped forces,
             rewards = 1 while alive, mask = alive; zeros at dead steps.
         """
-        if not isinstance(policy, LinearGaussianPolicy):
-            raise ValueError(f"policy must be a LinearGaussianPolicy, got {type(policy).__name__}")
-        if policy.gain.shape != (self.action_dim, self.state_dim):
-            raise ValueError(f"policy must have a (1, 4) gain for the cart-pole, got {policy.gain.shape}")
-        integral = (isinstance(n, (int, np.integer, float)) and not isinstance(n, bool)
-                    and math.isfinite(n) and n == int(n))
-        if not (integral and n >= 1):
-            raise ValueError(f"n must be a positive integer, got {n!r}")
-        n = int(n)
+        n = self._check_policy_and_n(policy, n)
         rng = as_generator(rng)
         H, b = self.horizon, self.action_bound
         K = policy.gain[0]
@@ -292,6 +284,77 @@ class CartPole:
         raw = np.ascontiguousarray(raw.T * mask)[:, :, None]
         acts = np.clip(raw, -b, b)  # the forces applied (clip(0) = 0 at dead steps)
         return Trajectories(feats, raw, acts, mask.astype(float), mask, self.gamma)
+
+    def _check_policy_and_n(self, policy: LinearGaussianPolicy, n: int) -> int:
+        """Validate a cart-pole policy and a batch size; returns ``n`` as an int."""
+        if not isinstance(policy, LinearGaussianPolicy):
+            raise ValueError(f"policy must be a LinearGaussianPolicy, got {type(policy).__name__}")
+        if policy.gain.shape != (self.action_dim, self.state_dim):
+            raise ValueError(f"policy must have a (1, 4) gain for the cart-pole, got {policy.gain.shape}")
+        integral = (isinstance(n, (int, np.integer, float)) and not isinstance(n, bool)
+                    and math.isfinite(n) and n == int(n))
+        if not (integral and n >= 1):
+            raise ValueError(f"n must be a positive integer, got {n!r}")
+        return int(n)
+
+    def gradient_batch(
+        self,
+        policy: LinearGaussianPolicy,
+        n: int,
+        rng: RNGLike = None,
+        estimator: str = "gpomdp",
+        baseline: bool = True,
+        score_action: str = "clipped",
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Gradient samples and undiscounted returns of a fresh batch, fused.
+
+        The same random numbers, drawn in the same order, as :meth:`simulate` (the (n, 4)
+        initial states, then (n, H, 1) standard normals), and the same numbers as
+        ``gradient_samples(policy, simulate(...), estimator, baseline, score_action)`` and
+        ``undiscounted_returns(simulate(...))`` up to rounding, without materialising the
+        trajectories: each episode is followed only until it terminates (see
+        :mod:`safepg.envs._cartpole_kernel`). The result does not depend on the number of
+        numba threads.
+
+        Parameters
+        ----------
+        policy : LinearGaussianPolicy
+            Policy with a (1, 4) gain.
+        n : int
+            Number of trajectories (>= 1).
+        rng : Generator, int or None
+            Random source (see :func:`safepg._rng.as_generator`).
+        estimator : {"gpomdp", "reinforce"}
+            Likelihood-ratio estimator (discounted with ``gamma``).
+        baseline : bool
+            Subtract the variance-minimising baseline.
+        score_action : {"clipped", "raw"}
+            Score the applied (clipped) force or the sampled one.
+
+        Returns
+        -------
+        samples : ndarray, shape (n, 4)
+            Per-trajectory gradient samples.
+        returns : ndarray, shape (n,)
+            *Undiscounted* returns, i.e. the episode lengths (at most H): the performance
+            the thesis reports for the cart-pole (:meth:`measured_returns`). Note that
+            :meth:`safepg.envs.LQG.gradient_batch` returns *discounted* returns instead.
+        """
+        from safepg.envs._cartpole_kernel import cartpole_gradient_samples
+
+        n = self._check_policy_and_n(policy, n)
+        if estimator not in ("reinforce", "gpomdp"):
+            raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+        if score_action not in ("clipped", "raw"):
+            raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+        rng = as_generator(rng)
+        s0 = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
+        z = rng.standard_normal((n, self.horizon, self.action_dim))
+        return cartpole_gradient_samples(
+            np.ascontiguousarray(policy.gain[0]), float(policy.cov_chol[0, 0]),
+            float(self.pole_length), float(self.cart_mass), float(self.pole_mass), float(self.gravity),
+            float(self.tau), s0, z, float(self.gamma), float(self.action_bound), float(self.x_threshold),
+            float(self.angle_threshold), score_action == "clipped", estimator == "reinforce", bool(baseline))
 
     def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
                       rng: RNGLike = None) -> Trajectories:
@@ -324,6 +387,15 @@ class CartPole:
         This is the performance the thesis reports for the cart-pole (at most H = 200).
         """
         return batch.rewards.sum(axis=1)
+
+    def measured_returns(self, batch: Trajectories) -> np.ndarray:
+        """The per-trajectory performance the learning loop records (J_hat), shape (N,).
+
+        For the cart-pole this is :meth:`undiscounted_returns`, the episode length the
+        thesis reports, not the discounted return the estimators use; it matches the
+        second output of :meth:`gradient_batch`.
+        """
+        return self.undiscounted_returns(batch)
 
 
 # ---------------------------------------------------------------------- gymnasium

@@ -1,0 +1,284 @@
+r"""Fused cart-pole simulation + gradient-sample kernel (numba).
+
+The reference path (``CartPole.simulate`` then :mod:`safepg.estimators`) steps every
+cart for as long as *any* cart is alive and then makes a dozen passes over (N, H, 4)
+arrays, most of whose entries are the zeros of dead steps. This kernel follows one
+trajectory at a time and stops at its last step, and gives the same numbers up to
+floating-point rounding (tested). The random numbers are drawn by the caller from the
+same ``numpy.random.Generator`` in the same order, so both paths see the same batch.
+
+Two things need care when the time loop stops early:
+
+- After termination the score is zero but the *cumulative* score of G(PO)MDP is not: it
+  stays at its final value, and the reference baseline's denominator
+  :math:`\sum_n G_{n,l}^2` counts it at every dead step l. Each chunk therefore records
+  the final :math:`G^2` of trajectories that ended at step T, and the denominators get
+  their running sum over T <= l.
+- Pass 2 subtracts :math:`\sum_l G_{n,l} b_l`; the dead steps contribute
+  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps are recomputed by
+  simulating the trajectory again from the same initial state and noise (the same code,
+  so the same bits) instead of keeping an (N, H, 4) array of cumulative scores.
+
+As in :mod:`safepg.envs._lqg_kernel`, trajectories are processed in fixed-size chunks in
+parallel; every chunk writes its own partial sums and the chunks are reduced in order,
+so the result does not depend on the number of threads.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+#: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
+#: bit of the result, is the same for any thread count; small enough that N = 4000 still
+#: spreads over a few threads, large enough that the per-chunk (H, 4) sums stay small.
+CHUNK = 512
+
+
+@njit(cache=True)
+def _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau):
+    """One explicit-Euler step; the same operations in the same order as ``step_dynamics``."""
+    sin = math.sin(beta)
+    cos = math.cos(beta)
+    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
+    x_acc = push - pole_mass * half * beta_acc * cos / total
+    return x + tau * x_dot, x_dot + tau * x_acc, beta + tau * beta_dot, beta_dot + tau * beta_acc
+
+
+@njit(cache=True)
+def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, x_threshold, angle_threshold,
+                score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept):
+    """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
+    lengths, and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
+    H = zz.shape[1]
+    half, total, pole_mass, gravity, tau = consts
+    k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
+    for n in range(lo, hi):
+        x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
+        g0 = g1 = g2 = g3 = 0.0  # cumulative scores
+        a0 = a1 = a2 = a3 = 0.0  # G(PO)MDP sample without baseline
+        disc = 1.0
+        ret = 0.0
+        T = H
+        for t in range(H):
+            mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
+            a_raw = mean + sigma * zz[n, t]
+            u = min(max(a_raw, -action_bound), action_bound)
+            d = ((u if score_clipped else a_raw) - mean) * inv_var
+            g0 += d * x
+            g1 += d * x_dot
+            g2 += d * beta
+            g3 += d * beta_dot
+            ret += disc  # reward 1: alive at t (the step into a failing state counts)
+            if not reinforce_estimator:
+                a0 += g0 * disc
+                a1 += g1 * disc
+                a2 += g2 * disc
+                a3 += g3 * disc
+                if baseline:
+                    num[t, 0] += g0 * g0 * disc
+                    num[t, 1] += g1 * g1 * disc
+                    num[t, 2] += g2 * g2 * disc
+                    num[t, 3] += g3 * g3 * disc
+                    den[t, 0] += g0 * g0
+                    den[t, 1] += g1 * g1
+                    den[t, 2] += g2 * g2
+                    den[t, 3] += g3 * g3
+            disc *= gamma
+            x, x_dot, beta, beta_dot = _euler(x, x_dot, beta, beta_dot, u, half, total, pole_mass, gravity, tau)
+            # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
+            if not (abs(x) <= x_threshold and abs(beta) <= angle_threshold):
+                T = t + 1
+                break
+        lengths[n] = T
+        if reinforce_estimator:
+            samples[n, 0] = g0 * ret
+            samples[n, 1] = g1 * ret
+            samples[n, 2] = g2 * ret
+            samples[n, 3] = g3 * ret
+            if baseline:
+                num[0, 0] += g0 * g0 * ret
+                num[0, 1] += g1 * g1 * ret
+                num[0, 2] += g2 * g2 * ret
+                num[0, 3] += g3 * g3 * ret
+                den[0, 0] += g0 * g0
+                den[0, 1] += g1 * g1
+                den[0, 2] += g2 * g2
+                den[0, 3] += g3 * g3
+                kept[n, 0], kept[n, 1], kept[n, 2], kept[n, 3] = g0, g1, g2, g3
+        else:
+            samples[n, 0], samples[n, 1], samples[n, 2], samples[n, 3] = a0, a1, a2, a3
+            if baseline and T < H:
+                ended[T, 0] += g0 * g0
+                ended[T, 1] += g1 * g1
+                ended[T, 2] += g2 * g2
+                ended[T, 3] += g3 * g3
+
+
+@njit(cache=True)
+def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_clipped, b, suffix,
+                 samples, lengths):
+    """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again."""
+    half, total, pole_mass, gravity, tau = consts
+    k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
+    for n in range(lo, hi):
+        x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
+        g0 = g1 = g2 = g3 = 0.0
+        a0 = a1 = a2 = a3 = 0.0  # sum_l G_l b_l over the live steps
+        T = int(lengths[n])
+        # Pass 1's trajectory again, operation for operation: it ends at T, no need to test.
+        for t in range(T):
+            mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
+            a_raw = mean + sigma * zz[n, t]
+            u = min(max(a_raw, -action_bound), action_bound)
+            d = ((u if score_clipped else a_raw) - mean) * inv_var
+            g0 += d * x
+            g1 += d * x_dot
+            g2 += d * beta
+            g3 += d * beta_dot
+            a0 += g0 * b[t, 0]
+            a1 += g1 * b[t, 1]
+            a2 += g2 * b[t, 2]
+            a3 += g3 * b[t, 3]
+            if t + 1 < T:  # the state after the last step is never used
+                x, x_dot, beta, beta_dot = _euler(x, x_dot, beta, beta_dot, u, half, total, pole_mass,
+                                                  gravity, tau)
+        samples[n, 0] -= a0 + g0 * suffix[T, 0]
+        samples[n, 1] -= a1 + g1 * suffix[T, 1]
+        samples[n, 2] -= a2 + g2 * suffix[T, 2]
+        samples[n, 3] -= a3 + g3 * suffix[T, 3]
+
+
+@njit(cache=True)
+def _baseline(num, den, ended, gpomdp_baseline):
+    """Baselines b (rows, 4) = num / den (0 where den = 0) and their suffix sums (H + 1, 4).
+
+    Serial, and in its own (non-parallel) function: inside the parallel kernel numba would
+    turn every array expression here into a parallel region with its own barrier, about a
+    thousand per call, which is slow on a busy machine. The chunks are added in order, so
+    the result does not depend on the number of threads.
+    """
+    n_chunks, rows = num.shape[0], num.shape[1]
+    nb = np.zeros((rows, 4))
+    db = np.zeros((rows, 4))
+    for c in range(n_chunks):
+        for t in range(rows):
+            for p in range(4):
+                nb[t, p] += num[c, t, p]
+                db[t, p] += den[c, t, p]
+    H = ended.shape[1] - 1
+    if gpomdp_baseline:
+        dead = np.zeros(4)  # sum of the final G^2 of the trajectories already ended at step t
+        for t in range(H):
+            for c in range(n_chunks):
+                for p in range(4):
+                    dead[p] += ended[c, t, p]
+            for p in range(4):
+                db[t, p] += dead[p]
+    b = np.zeros((rows, 4))
+    for t in range(rows):
+        for p in range(4):
+            if db[t, p] != 0.0:
+                b[t, p] = nb[t, p] / db[t, p]
+    # suffix[T] = sum_{l >= T} b_l: what a trajectory's frozen G contributes after it ended.
+    suffix = np.zeros((H + 1, 4))
+    if gpomdp_baseline:
+        for t in range(H - 1, -1, -1):
+            for p in range(4):
+                suffix[t, p] = suffix[t + 1, p] + b[t, p]
+    return b, suffix
+
+
+def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, cart_mass: float,
+                              pole_mass: float, gravity: float, tau: float, s0: np.ndarray, z: np.ndarray,
+                              gamma: float, action_bound: float, x_threshold: float, angle_threshold: float,
+                              score_clipped: bool, reinforce_estimator: bool,
+                              baseline: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Per-trajectory REINFORCE or G(PO)MDP samples (N, 4) and episode lengths (N,).
+
+    Parameters
+    ----------
+    K : ndarray, shape (4,)
+        Policy gain; the action is ``K @ s + sigma * z``.
+    sigma : float
+        Action standard deviation.
+    pole_length, cart_mass, pole_mass, gravity, tau : float
+        Physical constants (whole pole length, as in :class:`CartPole`).
+    s0 : ndarray, shape (N, 4)
+        Initial states.
+    z : ndarray, shape (N, H) or (N, H, 1)
+        Standard normals of the actions.
+    gamma : float
+        Discount factor of the estimators.
+    action_bound, x_threshold, angle_threshold : float
+        Force clip A-bar, termination |x| and |beta| (radians).
+    score_clipped, reinforce_estimator, baseline : bool
+        Score the clipped (applied) action instead of the sampled one; REINFORCE instead
+        of G(PO)MDP; subtract the variance-minimising baseline.
+
+    Returns
+    -------
+    samples : ndarray, shape (N, 4)
+        Gradient samples, as ``gradient_samples`` on the simulated batch.
+    lengths : ndarray, shape (N,)
+        Episode lengths (float), i.e. the undiscounted returns (reward 1 per live step).
+    """
+    # One compiled specialisation only: numba compiles again (about 10 s) for every new
+    # combination of argument types, e.g. a 3-D z, an int constant or a numpy bool flag.
+    K = np.ascontiguousarray(K, dtype=np.float64).reshape(4)
+    s0 = np.ascontiguousarray(s0, dtype=np.float64)
+    z = np.asarray(z, dtype=np.float64)
+    if s0.ndim != 2 or s0.shape[1] != 4:
+        raise ValueError(f"s0 must have shape (N, 4), got {s0.shape}")
+    if not (z.ndim == 2 or (z.ndim == 3 and z.shape[2] == 1)) or z.shape[0] != s0.shape[0]:
+        raise ValueError(f"z must have shape (N, H) or (N, H, 1) with N = {s0.shape[0]}, got {z.shape}")
+    zz = np.ascontiguousarray(z.reshape(z.shape[0], z.shape[1]))
+    return _fused(K, float(sigma), float(pole_length), float(cart_mass), float(pole_mass), float(gravity),
+                  float(tau), s0, zz, float(gamma), float(action_bound), float(x_threshold),
+                  float(angle_threshold), bool(score_clipped), bool(reinforce_estimator), bool(baseline))
+
+
+@njit(cache=True, parallel=True)
+def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, gamma, action_bound, x_threshold,
+           angle_threshold, score_clipped, reinforce_estimator, baseline):
+    """:func:`cartpole_gradient_samples` on normalised arguments (zz is (N, H))."""
+    N, H = zz.shape[0], zz.shape[1]
+    n_chunks = (N + CHUNK - 1) // CHUNK
+    samples = np.zeros((N, 4))
+    lengths = np.empty(N)
+    gpomdp_baseline = baseline and not reinforce_estimator
+    rows = 1 if reinforce_estimator else H
+    num = np.zeros((n_chunks if baseline else 1, rows, 4))
+    den = np.zeros((n_chunks if baseline else 1, rows, 4))
+    # Final G^2 of the trajectories of a chunk that ended at step T (index T), see above.
+    ended = np.zeros((n_chunks if gpomdp_baseline else 1, H + 1, 4))
+    # REINFORCE's baseline needs only the total score S_n, not a second simulation.
+    kept = np.empty((N if baseline and reinforce_estimator else 1, 4))
+    inv_var = 1.0 / (sigma * sigma)
+    consts = (0.5 * pole_length, cart_mass + pole_mass, pole_mass, gravity, tau)
+    # Without a baseline the sums are never touched: every chunk gets the same dummy row.
+    i_step = 1 if baseline else 0
+    j_step = 1 if gpomdp_baseline else 0
+    for c in prange(n_chunks):
+        i = c * i_step
+        j = c * j_step
+        _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, gamma,
+                    action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
+                    samples, lengths, num[i], den[i], ended[j], kept)
+    if not baseline:
+        return samples, lengths
+
+    b, suffix = _baseline(num, den, ended, gpomdp_baseline)
+    if reinforce_estimator:
+        for n in range(N):
+            for p in range(4):
+                samples[n, p] -= kept[n, p] * b[0, p]
+        return samples, lengths
+
+    for c in prange(n_chunks):
+        _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, action_bound,
+                     score_clipped, b, suffix, samples, lengths)
+    return samples, lengths

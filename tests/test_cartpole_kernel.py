@@ -1,0 +1,155 @@
+"""The fused cart-pole kernel (CartPole.gradient_batch) against the numpy reference path:
+same samples and returns, seeding, thread-count independence and input checks."""
+
+from __future__ import annotations
+
+import itertools
+
+import numba
+import numpy as np
+import pytest
+
+from safepg.envs._cartpole_kernel import CHUNK, cartpole_gradient_samples
+from safepg.envs.cartpole import CartPole
+from safepg.estimators import gradient_samples
+from safepg.policies import LinearGaussianPolicy
+
+# Balances the 1 m pole for the whole horizon (the gain of tests/test_cartpole.py).
+STABLE = np.array([1.0, 2.0, 40.0, 8.0])
+# (task, gain, sigma), chosen so that together they exercise every path of the kernel
+# (checked in test_cases_cover_the_kernel_paths).
+CASES = {
+    # The thesis's starting point: every episode falls within a few dozen steps.
+    "theta0": (CartPole.thesis(), np.zeros(4), 1.0),
+    # Every episode lasts 200 steps (no early stop); no clipping.
+    "stable": (CartPole.thesis(), STABLE, 1.0),
+    # A weaker stabilising gain with more noise: most episodes last 200 steps, the others
+    # fall at many different steps, and about 6% of the forces are clipped.
+    "mixed": (CartPole.thesis(), np.array([-1.0, 0.0, 30.0, 5.0]), 5.0),
+    # The doubled pole under heavy noise: a quarter of the forces clipped, a few falls.
+    "doubled": (CartPole.thesis_doubled(), STABLE, 8.0),
+}
+N = 2000  # several chunks, the last one partial
+
+
+def reference(task: CartPole, pol: LinearGaussianPolicy, n: int, seed: int, estimator: str, baseline: bool,
+              score_action: str) -> tuple[np.ndarray, np.ndarray]:
+    batch = task.simulate(pol, n, seed)
+    return gradient_samples(pol, batch, estimator, baseline, score_action), task.undiscounted_returns(batch)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("estimator", ["reinforce", "gpomdp"])
+def test_fused_matches_reference(case: str, estimator: str) -> None:
+    task, K, sig = CASES[case]
+    pol = LinearGaussianPolicy(K, sig)
+    batch = task.simulate(pol, N, 5)
+    lengths = task.undiscounted_returns(batch)
+    for baseline, score_action in itertools.product([True, False], ["clipped", "raw"]):
+        samples, returns = task.gradient_batch(pol, N, 5, estimator, baseline, score_action)
+        ref = gradient_samples(pol, batch, estimator, baseline, score_action)
+        assert samples.shape == (N, 4) and returns.shape == (N,)
+        np.testing.assert_allclose(samples, ref, rtol=1e-9, atol=1e-9, err_msg=f"{baseline=} {score_action=}")
+        np.testing.assert_array_equal(returns, lengths)
+
+
+def test_cases_cover_the_kernel_paths() -> None:
+    """Guards the test above against cases that silently stop exercising something."""
+    lengths = {c: CASES[c][0].gradient_batch(LinearGaussianPolicy(CASES[c][1], CASES[c][2]), N, 5)[1]
+               for c in CASES}
+    assert lengths["theta0"].max() < CASES["theta0"][0].horizon
+    assert np.all(lengths["stable"] == 200)
+    for c in ("mixed", "doubled"):
+        assert np.any(lengths[c] == 200) and np.any(lengths[c] < 200)
+    assert len(np.unique(lengths["mixed"])) > 20  # trajectories end at many different steps
+    for c in ("mixed", "doubled"):  # clipping is active, so the two score actions differ
+        task, K, sig = CASES[c]
+        pol = LinearGaussianPolicy(K, sig)
+        clipped = task.gradient_batch(pol, N, 5, score_action="clipped")[0]
+        raw = task.gradient_batch(pol, N, 5, score_action="raw")[0]
+        assert np.max(np.abs(clipped - raw)) > 1e-3
+
+
+@pytest.mark.parametrize("n", [1, 7, CHUNK, CHUNK + 1])
+def test_fused_matches_reference_at_chunk_edges(n: int) -> None:
+    task, K, sig = CASES["mixed"]
+    pol = LinearGaussianPolicy(K, sig)
+    for estimator in ("reinforce", "gpomdp"):
+        samples, returns = task.gradient_batch(pol, n, 11, estimator)
+        ref, lengths = reference(task, pol, n, 11, estimator, True, "clipped")
+        np.testing.assert_allclose(samples, ref, rtol=1e-9, atol=1e-9)
+        np.testing.assert_array_equal(returns, lengths)
+
+
+def test_same_seed_same_bits_and_generator_advances_like_simulate() -> None:
+    task, K, sig = CASES["mixed"]
+    pol = LinearGaussianPolicy(K, sig)
+    a = task.gradient_batch(pol, 500, 3)
+    b = task.gradient_batch(pol, 500, np.random.default_rng(3))
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    assert not np.array_equal(a[0], task.gradient_batch(pol, 500, 4)[0])
+    # The generator is left where simulate leaves it, so the two paths can be interleaved.
+    r1, r2 = np.random.default_rng(9), np.random.default_rng(9)
+    task.gradient_batch(pol, 300, r1)
+    task.simulate(pol, 300, r2)
+    assert r1.random() == r2.random()
+
+
+@pytest.mark.parametrize("estimator", ["reinforce", "gpomdp"])
+def test_fused_result_does_not_depend_on_thread_count(estimator: str) -> None:
+    task, K, sig = CASES["mixed"]
+    pol = LinearGaussianPolicy(K, sig)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = task.gradient_batch(pol, 5 * CHUNK + 3, 2, estimator)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = task.gradient_batch(pol, 5 * CHUNK + 3, 2, estimator)
+    finally:
+        numba.set_num_threads(before)
+    assert np.array_equal(one[0], two[0]) and np.array_equal(one[1], two[1])
+
+
+def test_returns_are_episode_lengths_and_measured_returns() -> None:
+    task, K, sig = CASES["mixed"]
+    pol = LinearGaussianPolicy(K, sig)
+    returns = task.gradient_batch(pol, 1000, 8)[1]
+    batch = task.simulate(pol, 1000, 8)
+    np.testing.assert_array_equal(returns, batch.mask.sum(axis=1))  # reward 1 per live step
+    np.testing.assert_array_equal(task.measured_returns(batch), task.undiscounted_returns(batch))
+    np.testing.assert_array_equal(task.measured_returns(batch), returns)
+    assert returns.min() >= 1 and returns.max() <= task.horizon
+
+
+def test_kernel_takes_2d_or_3d_noise() -> None:
+    task, K, sig = CASES["mixed"]
+    rng = np.random.default_rng(0)
+    s0 = rng.uniform(-0.05, 0.05, size=(40, 4))
+    z = rng.standard_normal((40, task.horizon, 1))
+    args = (sig, task.pole_length, task.cart_mass, task.pole_mass, task.gravity, task.tau)
+    tail = (task.gamma, task.action_bound, task.x_threshold, task.angle_threshold, True, False, True)
+    three = cartpole_gradient_samples(K, *args, s0, z, *tail)
+    two = cartpole_gradient_samples(K, *args, s0, z[:, :, 0], *tail)  # a strided view, copied
+    assert np.array_equal(three[0], two[0]) and np.array_equal(three[1], two[1])
+    with pytest.raises(ValueError, match="^z "):
+        cartpole_gradient_samples(K, *args, s0, np.zeros((40, task.horizon, 2)), *tail)
+    with pytest.raises(ValueError, match="^z "):
+        cartpole_gradient_samples(K, *args, s0, z[:39], *tail)
+    with pytest.raises(ValueError, match="^s0 "):
+        cartpole_gradient_samples(K, *args, s0[:, :3], z, *tail)
+
+
+def test_fused_bad_input() -> None:
+    task = CartPole.thesis()
+    pol = LinearGaussianPolicy(np.zeros(4), 1.0)
+    with pytest.raises(ValueError, match="^estimator"):
+        task.gradient_batch(pol, 10, 0, "a2c")
+    with pytest.raises(ValueError, match="^score_action"):
+        task.gradient_batch(pol, 10, 0, score_action="mean")
+    for n in (0, -3, 2.5, True, float("nan"), "10"):
+        with pytest.raises(ValueError, match="^n "):
+            task.gradient_batch(pol, n, 0)
+    with pytest.raises(ValueError, match="^policy"):
+        task.gradient_batch(LinearGaussianPolicy(np.zeros(3), 1.0), 10, 0)
+    with pytest.raises(ValueError, match="^policy"):
+        task.gradient_batch(np.zeros(4), 10, 0)
