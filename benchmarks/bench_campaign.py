@@ -1,8 +1,8 @@
-"""Wall time of the Section 5.1 campaign at the thesis's scale, from an empty cache.
+"""Wall time of Chapter 5's experiments at the thesis's scale, from an empty cache.
 
-Runs Table 5.1 (24 configs x 5 seeds x 10^6 trajectories) and Table 5.2 / Figures
-5.1-5.4 (12 configs x 5 seeds x 3*10^7 trajectories) into a fresh results folder with
-all cores, then reruns them to time the cached path.
+Runs each named experiment (default: every one in ``safepg.experiments``) into a fresh
+results folder with all cores, then reruns it to time the cached path, and merges the
+timings into ``benchmarks/campaign_timings.json`` (which the chapters quote).
 
 Usage: ``python benchmarks/bench_campaign.py [--experiments table-5.1 table-5.2] [--keep DIR]``
 """
@@ -17,12 +17,14 @@ import tempfile
 import time
 from pathlib import Path
 
-from safepg.experiments import report, run_experiment
+from safepg.experiments import EXPERIMENTS, report, run_experiment
+
+TIMINGS = Path(__file__).with_name("campaign_timings.json")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--experiments", nargs="+", default=["table-5.1", "table-5.2"])
+    ap.add_argument("--experiments", nargs="+", default=list(EXPERIMENTS))
     ap.add_argument("--keep", type=Path, help="store the results here instead of a temp folder")
     ap.add_argument("--jobs", type=int, default=-1)
     args = ap.parse_args()
@@ -45,6 +47,10 @@ def main() -> None:
                       f"improvement_ratio={row['improvement_ratio']['mean']:.4f}  thesis={row['thesis']}")
         total = sum(t["cold_s"] for t in timings.values())
         print(json.dumps({"cores": os.cpu_count(), "total_cold_s": round(total, 1), **timings}))
+        stored = json.loads(TIMINGS.read_text()) if TIMINGS.exists() else {}
+        stored.update({k: {**v, "cores": os.cpu_count(), "date": time.strftime("%Y-%m-%d")}
+                       for k, v in timings.items()})
+        TIMINGS.write_text(json.dumps(stored, indent=1, sort_keys=True) + "\n")
     finally:
         if args.keep is None:
             shutil.rmtree(root, ignore_errors=True)

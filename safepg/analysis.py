@@ -85,6 +85,22 @@ def table_5_2(report: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
+def table_upsilon(report: dict[str, Any]) -> list[dict[str, Any]]:
+    """Rows of Tables 5.3 and 5.4: average performance and improvement ratio per method,
+    ours (mean and 95% CI over seeds) beside the thesis's, with the differences."""
+    rows = []
+    for c in report["configs"]:
+        ub, ir, th = c["upsilon_bar"], c["improvement_ratio"], c["thesis"] or {}
+        up = compare(ub["mean"], th.get("upsilon_bar"))
+        imp = compare(ir["mean"], th.get("improvement_ratio"))
+        rows.append({"name": c["name"], "batch_size": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+                     "upsilon_bar": up["ours"], "upsilon_ci95": ub["ci95"], "thesis_upsilon_bar": up["thesis"],
+                     "upsilon_difference": up["difference"],
+                     "improvement_ratio": imp["ours"], "improvement_ci95": ir["ci95"],
+                     "thesis_improvement_ratio": imp["thesis"], "improvement_difference": imp["difference"]})
+    return rows
+
+
 class Table(str):
     """A Markdown table that renders as a table in notebooks and prints as its text
     (so nbval compares the numbers, not an object's address)."""

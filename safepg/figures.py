@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from safepg import plotting
-from safepg.analysis import by_iteration, mean_band, performance_on_grid
+from safepg.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
 from safepg.bounds import ErrorBound
 from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
@@ -27,15 +27,16 @@ def _grid(records: Records, points: int = 600) -> np.ndarray:
 
 
 def _performance_panel(ax: plt.Axes, records: Records, labels: Mapping[str, str],
-                       styles: Mapping[str, dict]) -> None:
+                       styles: Mapping[str, dict], measured: bool = False) -> None:
     grid = _grid({k: records[k] for k in labels})
+    curve = measured_on_grid if measured else performance_on_grid
     for name, label in labels.items():
-        mean, lo, hi = mean_band(performance_on_grid(records[name], grid))
+        mean, lo, hi = mean_band(curve(records[name], grid))
         st = styles[name]
         ax.plot(grid, mean, label=label, **st)
         ax.fill_between(grid, lo, hi, color=st.get("color"), alpha=0.2, linewidth=0)
     ax.set_xlabel("trajectories")
-    ax.set_ylabel(r"expected performance $J(\theta)$")
+    ax.set_ylabel("average return over the batch" if measured else r"expected performance $J(\theta)$")
     ax.legend(fontsize="small")
 
 
@@ -100,6 +101,43 @@ def figure_batch_sizes(records: Records, configs: Sequence, log: bool = True) ->
     ax.set_ylabel("batch size $N$")
     if log:
         ax.set_yscale("log")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+#: Colours of the curves of Sections 5.2-5.3 (adaptive method, and the methods it is compared to).
+_COMPARISON_COLORS = ("#7d4fb0", "#3b6fb6", "#d98c2b", "#2e9e5b")
+
+
+def figure_comparison(records: Records, labels: Mapping[str, str], measured: bool = False) -> Figure:
+    """Figures 5.5, 5.8 and 5.9: performance over trajectories of a few methods.
+
+    ``labels`` maps a config name to its legend label. The closed-form J is held over
+    each batch (Figures 5.5, 5.8); with ``measured=True`` the curve is the batch-average
+    return, "used as representative for all the trajectories in the batch" (Figure 5.9).
+    Seed mean with the min-max band.
+    """
+    fig, ax = plt.subplots(figsize=(7, 4))
+    styles = {name: {"color": col} for name, col in zip(labels, _COMPARISON_COLORS)}
+    _performance_panel(ax, records, labels, styles, measured)
+    fig.tight_layout()
+    return fig
+
+
+def figure_5_6(records: Records, labels: Mapping[str, str]) -> Figure:
+    r"""Figure 5.6: magnitude of the step size over iterations, the scalar
+    :math:`\hat\alpha^*` of [24] against :math:`\|\Lambda^*\|_\infty` (the coordinate
+    step moves one component, so its infinity norm is the recorded alpha)."""
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for (name, label), col in zip(labels.items(), _COMPARISON_COLORS):
+        mean, lo, hi = mean_band(by_iteration(records[name], "alpha"))
+        it = np.arange(1, mean.size + 1)
+        ax.plot(it, mean, color=col, label=label)
+        ax.fill_between(it, lo, hi, color=col, alpha=0.2, linewidth=0)
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("step size")
+    ax.set_yscale("log")
     ax.legend(fontsize="small")
     fig.tight_layout()
     return fig

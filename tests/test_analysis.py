@@ -1,8 +1,17 @@
 """Curves and tables drawn from records."""
 
 import numpy as np
+import pytest
 
-from safepg.analysis import by_iteration, markdown_table, mean_band, performance_on_grid, table_5_2
+from safepg.analysis import (
+    by_iteration,
+    markdown_table,
+    mean_band,
+    measured_on_grid,
+    performance_on_grid,
+    table_5_2,
+    table_upsilon,
+)
 from safepg.learning import LearningRecord
 
 
@@ -77,3 +86,40 @@ def test_simulated_objective_optimum_differs_from_closed_form():
     t = np.linspace(-0.9, -0.4, 2001)
     best = t[np.argmax(f(t))]
     assert -0.70 < best < -0.60 and abs(f(best) - (-9.56)) < 0.05
+
+
+def test_measured_on_grid_holds_each_batch_average():
+    r = rec([10, 20], [-5.0, -4.0, -3.0])  # J_hat = J[:-1] + 1
+    got = measured_on_grid([r], np.array([1, 10, 11, 30, 31]))[0]
+    np.testing.assert_array_equal(got, [-4, -4, -3, -3, np.nan])
+
+
+def test_table_upsilon_differences():
+    report = {"configs": [
+        {"name": "adaptive", "batch_size": None, "alpha": None, "seeds": 5,
+         "upsilon_bar": {"mean": 184.2, "ci95": [183.0, 185.4]},
+         "improvement_ratio": {"mean": 0.55, "ci95": [0.5, 0.6]},
+         "thesis": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301}},
+        {"name": "extra", "batch_size": 10, "alpha": 0.1, "seeds": 1,
+         "upsilon_bar": {"mean": 1.0, "ci95": [1.0, 1.0]}, "improvement_ratio": {"mean": 1.0, "ci95": [1, 1]},
+         "thesis": None}]}
+    a, extra = table_upsilon(report)
+    assert a["upsilon_difference"] == pytest.approx(184.2 - 193.12)
+    assert a["improvement_difference"] == pytest.approx(0.55 - 0.5301)
+    assert a["batch_size"] is None and extra["thesis_upsilon_bar"] is None and extra["upsilon_difference"] is None
+
+
+def test_comparison_figures_draw_the_seed_means():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from safepg.figures import figure_5_6, figure_comparison
+
+    recs = {"a": [rec([10, 20], [-5.0, -4.0, -3.0])], "b": [rec([30], [-6.0, -1.0])]}
+    fig = figure_comparison(recs, {"a": "A", "b": "B"}, measured=True)
+    lines = fig.axes[0].get_lines()
+    assert [ln.get_label() for ln in lines] == ["A", "B"]
+    assert set(lines[0].get_ydata()[:10]) == {-4.0} and "batch" in fig.axes[0].get_ylabel()
+    recs["a"][0].alpha[:] = [1e-3, 1e-4]
+    fig = figure_5_6(recs, {"a": "A"})
+    np.testing.assert_array_equal(fig.axes[0].get_lines()[0].get_ydata(), [1e-3, 1e-4])

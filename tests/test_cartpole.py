@@ -19,7 +19,7 @@ gym = pytest.importorskip("gymnasium")
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv  # noqa: E402
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 
-from safepg.envs.cartpole import ContinuousCartPoleEnv  # noqa: E402
+from safepg.envs.cartpole import ContinuousCartPoleEnv, gymnasium_step  # noqa: E402
 
 THR = math.radians(41.8)
 # Balances the 1 m pole for the whole horizon (checked in test_simulate_reaches_every_ending).
@@ -61,6 +61,7 @@ def test_step_matches_gymnasium(pole_length: float) -> None:
     env = gym_cartpole(half_length=pole_length / 2)  # gymnasium's length is half the pole
     theirs = np.array([gym_step(env, s, f)[0] for s, f in zip(states, forces)])
     np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(gymnasium_step(states, forces, pole_length), theirs, rtol=0, atol=0)
     if pole_length == 2.0:  # the doubled pole really changes the dynamics
         assert np.max(np.abs(ours - step_dynamics(states, forces))) > 1e-3
 

@@ -114,3 +114,70 @@ def test_cli_list_run_report(root, capsys):
 def test_unknown_experiment():
     with pytest.raises(ValueError, match="^experiment"):
         ex.get_experiment("table-9")
+
+
+def test_sections_5_2_and_5_3_definitions():
+    f55, t53 = ex.get_experiment("figures-5.5-5.6"), ex.get_experiment("table-5.3")
+    for c in f55.configs + t53.configs:
+        assert c.env == "lqg2d-gamma0.9" and c.theta0 == (0.0,) * 4 and c.budget == 30_000_000
+    assert {c.step for c in f55.configs} == {"scalar", "coordinate"}
+    assert all(c.batch_size == 2000 and c.alpha is None and c.bound == "chebyshev" and c.delta == 0.95
+               for c in f55.configs)
+    adaptive, n1000, n100 = t53.configs
+    assert (adaptive.algorithm, adaptive.bound, adaptive.empirical_range) == ("adaptive", "bernstein", True)
+    assert (n1000.batch_size, n1000.alpha, n100.batch_size, n100.alpha) == (1000, 1e-6, 100, 1e-6)
+    env = ex.make_env("lqg2d-gamma0.9")
+    assert env.dim == 2 and env.gamma == 0.9 and ex.make_env("lqg2d").gamma == 0.95
+    base, t54 = ex.get_experiment("cartpole-baseline"), ex.get_experiment("table-5.4")
+    (b,) = base.configs
+    assert (b.env, b.batch_size, b.alpha, b.target_return) == ("cartpole", 4000, 0.01, 195.0)
+    assert {c.env for c in t54.configs} == {"cartpole-doubled"} and len({c.budget for c in t54.configs}) == 1
+    assert all(c.warm_start == "cartpole-baseline" for c in t54.configs)
+    assert base.performance == t54.performance == "J_hat" and t53.performance == "J"
+    assert ex.make_env("cartpole-doubled").pole_length == 2 * ex.make_env("cartpole").pole_length
+
+
+def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
+    base = ex.scaled(ex.get_experiment("cartpole-baseline"), seeds=2)
+    # A cheap stand-in for the baseline: the same experiment name, two iterations.
+    cheap = replace(base, configs=(replace(base.configs[0], budget=8000, target_return=None),))
+    t54 = ex.scaled(ex.get_experiment("table-5.4"), seeds=2, budget=12_000)
+    import safepg.experiments as mod
+
+    saved = dict(mod.EXPERIMENTS)
+    mod.EXPERIMENTS["cartpole-baseline"] = cheap
+    try:
+        recs = ex.run_experiment(t54, jobs=1, progress=False)
+        baselines = ex.load_experiment(cheap)["baseline"]
+        assert len(baselines) == 2 and all(r.iterations == 2 for r in baselines)
+        for name in ("adaptive", "N=4000"):
+            for k, r in enumerate(recs[name]):
+                np.testing.assert_array_equal(r.theta[0], baselines[k].theta_final)
+        assert not np.array_equal(baselines[0].theta_final, baselines[1].theta_final)
+        # The starting policy is part of a run's identity.
+        key = t54.configs[0].key()
+        mod.EXPERIMENTS["cartpole-baseline"] = replace(cheap, configs=(replace(cheap.configs[0], alpha=0.02),))
+        assert t54.configs[0].key() != key
+    finally:
+        mod.EXPERIMENTS.clear()
+        mod.EXPERIMENTS.update(saved)
+    rep = ex.report(t54, recs)
+    rows = {r["name"]: r for r in rep["configs"]}
+    assert rows["adaptive"]["batch_size"] is None and rows["adaptive"]["alpha"] is None
+    assert (rows["N=4000"]["batch_size"], rows["N=4000"]["alpha"]) == (4000, 0.01)
+    for name, row in rows.items():
+        assert row["improvement_ratio_on"] == "J_hat" and row["J_final"] is None and row["J_at"] == {}
+        expected = np.mean([r.improvement_ratio("J_hat") for r in recs[name]])
+        assert row["improvement_ratio"]["mean"] == pytest.approx(expected)
+        assert row["upsilon_bar"]["mean"] == pytest.approx(np.mean([r.J_hat @ r.batch_size / r.trajectories
+                                                                    for r in recs[name]]))
+        assert 1 <= row["J_hat_final"] <= 200  # undiscounted episode lengths
+    assert rows["N=4000"]["components_updated"] == [0, 1, 2, 3]
+
+
+def test_report_lists_the_components_each_method_updated(root):
+    exp = ex.scaled(ex.get_experiment("figures-5.5-5.6"), seeds=1, budget=20_000)
+    rows = {r["name"]: r for r in ex.report(exp, ex.run_experiment(exp, jobs=1, progress=False))["configs"]}
+    assert rows["coordinate"]["components_updated"] == [0, 3]  # only the diagonal moves
+    assert rows["scalar"]["components_updated"] == [0, 1, 2, 3]
+    assert rows["coordinate"]["improvement_ratio_on"] == "J"

@@ -52,6 +52,7 @@ is the episode length (at most H = 200).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -481,6 +482,43 @@ if _gym is not None:
             self._terminated = not bool(self.task.alive(self.state))
             self._truncated = not self._terminated and self._t >= self.task.horizon
             return self.state.copy(), 1.0, self._terminated, self._truncated, {}
+
+    def gymnasium_step(states: np.ndarray, forces: np.ndarray, pole_length: float = _POLE_LENGTH) -> np.ndarray:
+        """One step of gymnasium's own ``CartPoleEnv`` from each state with each force.
+
+        The independent implementation :func:`step_dynamics` is checked against (tests
+        and the cart-pole chapter). gymnasium's env has a fixed force magnitude and a
+        binary action, so each step sets ``force_mag = |force|`` and picks the sign with
+        the action; its ``length`` is half the pole. One Python step per state: a
+        reference, not a simulator.
+
+        Parameters
+        ----------
+        states : ndarray, shape (n, 4)
+        forces : ndarray, shape (n,)
+        pole_length : float
+            Whole pole length in m.
+        """
+        from gymnasium.envs.classic_control.cartpole import CartPoleEnv
+
+        S = np.asarray(states, dtype=float).reshape(-1, 4)
+        F = np.asarray(forces, dtype=float).reshape(-1)
+        if F.shape[0] != S.shape[0]:
+            raise ValueError(f"forces must have one entry per state, got {F.shape[0]} for {S.shape[0]} states")
+        env = CartPoleEnv()
+        env.reset(seed=0)
+        env.length = 0.5 * pole_length
+        env.polemass_length = env.masspole * env.length  # cached in __init__: keep it consistent
+        out = np.empty_like(S)
+        with warnings.catch_warnings():  # stepping "after termination" is what we want here
+            warnings.simplefilter("ignore")
+            for i, (s, f) in enumerate(zip(S, F)):
+                env.state = s.copy()
+                env.steps_beyond_terminated = None
+                env.force_mag = abs(f)
+                env.step(1 if f >= 0 else 0)
+                out[i] = env.state
+        return out
 
     def register_envs() -> None:
         """Register :class:`ContinuousCartPoleEnv` as ``"safepg/ContinuousCartPole-v0"``.
