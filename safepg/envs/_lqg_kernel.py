@@ -79,6 +79,186 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, s0, z, gamma, bs, ba, clip,
     return samples, returns
 
 
+@njit(cache=True, parallel=True)
+def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score_clipped,
+                           reinforce_estimator, baseline):
+    """Two-dimensional (m = 2) version of :func:`lqg_gradient_samples`.
+
+    Same arguments, semantics and outputs (samples (N, 4), returns (N,)). Section 5.2's
+    campaign is all m = 2 steps; the runtime-sized m x m loops of the generic kernel keep
+    state, action, scores and sample sums in memory and index every matrix through its
+    strides, which dominates at m = 2. Here the 2 x 2 algebra is unrolled: the matrices
+    are read once into locals and the per-trajectory state (s, a, u, the four cumulative
+    scores, the four sample sums) lives in registers. The only per-step memory traffic
+    left is reading z[n, t, :], adding to the chunk's L1-resident baseline sums
+    num/den[c, t, :] and, with a G(PO)MDP baseline, storing the four cumulative scores
+    kept[n, t, :] contiguously (pass 2 needs them).
+
+    Every sum is formed in the same order as in the generic kernel, so the two give the
+    same bits (tested to 1e-12 relative); swapping kernels does not change a seeded run.
+    That rules out regrouping the cost quadratic forms to save a few multiplies.
+    Interleaving two trajectories, to overlap their serial state -> action -> state
+    chains, measured no faster: the step is bound by scalar arithmetic, not latency.
+
+    Parameters
+    ----------
+    K, L, Pm, A, B, Q, R : ndarray (2, 2)
+        Gain, lower Cholesky factor of the policy covariance (its upper entry is not
+        read), precision, dynamics and cost matrices.
+    s0 : ndarray (N, 2)
+        Initial states.
+    z : ndarray (N, H, 2)
+        Standard normals; the action noise is L z.
+    gamma, bs, ba : float
+        Discount, state and action box half-widths.
+    clip, score_clipped, reinforce_estimator, baseline : bool
+        As in :func:`lqg_gradient_samples`.
+
+    Returns
+    -------
+    samples : ndarray (N, 4)
+        Per-trajectory gradient samples, flattened like K (row-major).
+    returns : ndarray (N,)
+        Discounted returns.
+    """
+    N, H = z.shape[0], z.shape[1]
+    n_chunks = (N + CHUNK - 1) // CHUNK
+    samples = np.empty((N, 4))
+    returns = np.empty(N)
+    rows = 1 if reinforce_estimator else H
+    num = np.zeros((n_chunks, rows, 4))
+    den = np.zeros((n_chunks, rows, 4))
+    kept = np.empty((N if baseline else 1, rows, 4))
+    k00, k01, k10, k11 = K[0, 0], K[0, 1], K[1, 0], K[1, 1]
+    l00, l10, l11 = L[0, 0], L[1, 0], L[1, 1]
+    p00, p01, p10, p11 = Pm[0, 0], Pm[0, 1], Pm[1, 0], Pm[1, 1]
+    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
+    b00, b01, b10, b11 = B[0, 0], B[0, 1], B[1, 0], B[1, 1]
+    q00, q01, q10, q11 = Q[0, 0], Q[0, 1], Q[1, 0], Q[1, 1]
+    r00, r01, r10, r11 = R[0, 0], R[0, 1], R[1, 0], R[1, 1]
+    for c in prange(n_chunks):
+        for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
+            x0 = s0[n, 0]
+            x1 = s0[n, 1]
+            g00 = 0.0
+            g01 = 0.0
+            g10 = 0.0
+            g11 = 0.0
+            f00 = 0.0
+            f01 = 0.0
+            f10 = 0.0
+            f11 = 0.0
+            disc = 1.0
+            ret = 0.0
+            for t in range(H):
+                m0 = k00 * x0 + k01 * x1
+                m1 = k10 * x0 + k11 * x1
+                z0 = z[n, t, 0]
+                z1 = z[n, t, 1]
+                a0 = m0 + l00 * z0
+                a1 = m1 + (l10 * z0 + l11 * z1)
+                if clip:
+                    u0 = min(max(a0, -ba), ba)
+                    u1 = min(max(a1, -ba), ba)
+                else:
+                    u0 = a0
+                    u1 = a1
+                # (i, j) terms summed in the generic kernel's order, so results match bit for bit.
+                cost = (x0 * q00 * x0 + u0 * r00 * u0) + (x0 * q01 * x1 + u0 * r01 * u1)
+                cost = cost + (x1 * q10 * x0 + u1 * r10 * u0)
+                cost = cost + (x1 * q11 * x1 + u1 * r11 * u1)
+                dr = -0.5 * cost * disc
+                ret += dr
+                if score_clipped:
+                    e0 = u0 - m0
+                    e1 = u1 - m1
+                else:
+                    e0 = a0 - m0
+                    e1 = a1 - m1
+                d0 = p00 * e0 + p01 * e1
+                d1 = p10 * e0 + p11 * e1
+                g00 += d0 * x0  # score of Section 2.3.13, summed over k <= t
+                g01 += d0 * x1
+                g10 += d1 * x0
+                g11 += d1 * x1
+                if not reinforce_estimator:
+                    f00 += g00 * dr
+                    f01 += g01 * dr
+                    f10 += g10 * dr
+                    f11 += g11 * dr
+                    h00 = g00 * g00
+                    h01 = g01 * g01
+                    h10 = g10 * g10
+                    h11 = g11 * g11
+                    num[c, t, 0] += h00 * dr
+                    num[c, t, 1] += h01 * dr
+                    num[c, t, 2] += h10 * dr
+                    num[c, t, 3] += h11 * dr
+                    den[c, t, 0] += h00
+                    den[c, t, 1] += h01
+                    den[c, t, 2] += h10
+                    den[c, t, 3] += h11
+                    if baseline:
+                        kept[n, t, 0] = g00
+                        kept[n, t, 1] = g01
+                        kept[n, t, 2] = g10
+                        kept[n, t, 3] = g11
+                disc *= gamma
+                y0 = (a00 * x0 + b00 * u0) + (a01 * x1 + b01 * u1)
+                y1 = (a10 * x0 + b10 * u0) + (a11 * x1 + b11 * u1)
+                if clip:
+                    x0 = min(max(y0, -bs), bs)
+                    x1 = min(max(y1, -bs), bs)
+                else:
+                    x0 = y0
+                    x1 = y1
+            returns[n] = ret
+            if reinforce_estimator:
+                h00 = g00 * g00
+                h01 = g01 * g01
+                h10 = g10 * g10
+                h11 = g11 * g11
+                num[c, 0, 0] += h00 * ret
+                num[c, 0, 1] += h01 * ret
+                num[c, 0, 2] += h10 * ret
+                num[c, 0, 3] += h11 * ret
+                den[c, 0, 0] += h00
+                den[c, 0, 1] += h01
+                den[c, 0, 2] += h10
+                den[c, 0, 3] += h11
+                f00 = g00 * ret
+                f01 = g01 * ret
+                f10 = g10 * ret
+                f11 = g11 * ret
+                if baseline:
+                    kept[n, 0, 0] = g00
+                    kept[n, 0, 1] = g01
+                    kept[n, 0, 2] = g10
+                    kept[n, 0, 3] = g11
+            samples[n, 0] = f00
+            samples[n, 1] = f01
+            samples[n, 2] = f10
+            samples[n, 3] = f11
+    if baseline:
+        b = _baseline(num, den)
+        for c in prange(n_chunks):
+            for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
+                c0 = 0.0
+                c1 = 0.0
+                c2 = 0.0
+                c3 = 0.0
+                for t in range(rows):
+                    c0 += kept[n, t, 0] * b[t, 0]
+                    c1 += kept[n, t, 1] * b[t, 1]
+                    c2 += kept[n, t, 2] * b[t, 2]
+                    c3 += kept[n, t, 3] * b[t, 3]
+                samples[n, 0] -= c0
+                samples[n, 1] -= c1
+                samples[n, 2] -= c2
+                samples[n, 3] -= c3
+    return samples, returns
+
+
 @njit(cache=True)
 def _baseline(num, den):
     """b = (sum of chunk numerators) / (sum of chunk denominators), 0 where den = 0.

@@ -302,7 +302,7 @@ class LQG:
         as ``gradient_samples(policy, simulate(...), ...)`` up to rounding, without
         materialising the trajectories (see :mod:`safepg.envs._lqg_kernel`).
         """
-        from safepg.envs._lqg_kernel import lqg1d_gradient_samples, lqg_gradient_samples
+        from safepg.envs._lqg_kernel import lqg1d_gradient_samples, lqg2d_gradient_samples, lqg_gradient_samples
 
         self._check_policy(policy)
         if int(n) != n or n < 1:
@@ -321,5 +321,6 @@ class LQG:
             return lqg1d_gradient_samples(
                 float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
                 float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), s0, z, *flags)
-        return lqg_gradient_samples(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R,
-                                    s0, z, *flags)
+        # m = 2 (Section 5.2) has its own unrolled kernel; m >= 3 uses the generic loops.
+        kernel = lqg2d_gradient_samples if self.dim == 2 else lqg_gradient_samples
+        return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, s0, z, *flags)
