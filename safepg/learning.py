@@ -178,7 +178,8 @@ class _Update:
     next_n: int
 
 
-UpdateRule = Callable[[np.ndarray, int], _Update]
+#: (samples (n, m), their mean, n) -> the update. The loop computes the mean once.
+UpdateRule = Callable[[np.ndarray, np.ndarray, int], _Update]
 
 
 def _closed_form(task: Task, thetas: np.ndarray, sigma: float) -> np.ndarray:
@@ -247,19 +248,21 @@ def _learn(
                 break
             samples, returns = _collect(task, policy, n, rng, estimator, baseline, score_action)
             with np.errstate(over="ignore", invalid="ignore"):  # a non-finite mean is handled just below
-                grad = samples.mean(axis=0)
+                # sum / n is what ndarray.mean computes (same bits), without its Python overhead:
+                # a run with N = 100 has 3*10^5 iterations.
+                grad = samples.sum(axis=0) / n
             if not np.all(np.isfinite(grad)):
                 if stop_on_divergence:
                     diverged = True
                     break
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
-            J_hat = float(returns.mean())
+            J_hat = float(returns.sum() / n)
             if target_return is not None and J_hat >= target_return:
                 # The policy that produced this batch is the result: record the batch, keep theta.
                 up = _Update(np.zeros_like(grad), 0.0, -1, 0.0, True, n)
                 reached = True
             else:
-                up = rule(samples, n)
+                up = rule(samples, grad, n)
             theta = theta + up.delta_theta
             policy = policy.with_theta(theta)
             used += n
@@ -363,8 +366,7 @@ def adaptive_pg(
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
 
-    def rule(samples: np.ndarray, n: int) -> _Update:
-        grad = samples.mean(axis=0)
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int) -> _Update:
         k = int(np.argmax(np.abs(grad)))
         g = float(abs(grad[k]))
         eb: ErrorBound = error_bound(bound, samples[:, k], delta, constants, estimator, empirical_range,
@@ -434,8 +436,7 @@ def vanilla_pg(
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
 
-    def rule(samples: np.ndarray, n: int) -> _Update:
-        grad = samples.mean(axis=0)
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int) -> _Update:
         k = int(np.argmax(np.abs(grad)))
         eps, safe, a = 0.0, True, alpha
         if alpha is None:
