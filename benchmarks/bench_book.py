@@ -41,11 +41,14 @@ def main() -> None:
                         ignore=shutil.ignore_patterns("*.py"))
         assert not (work / "results").exists() and not (work / "_build").exists()
         t0 = time.perf_counter()
-        subprocess.run(["jupyter-book", "build", str(work), "-W", "-n", "--keep-going"], check=True,
+        # From inside the copy: _config.yml's cache path is relative to the working directory.
+        subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=work, check=True,
                        stdout=subprocess.DEVNULL)
         wall = time.perf_counter() - t0
         cache = get_cache(str(work / "_build" / ".jupyter_cache"))
         chapters = {Path(r.uri).stem: round(r.data["execution_seconds"], 1) for r in cache.list_cache_records()}
+        if len(chapters) < sum(1 for _ in (work / "book").glob("*.ipynb")):
+            raise RuntimeError(f"only {sorted(chapters)} were executed: the build did not start from empty")
         out = {"cores": os.cpu_count(), "date": time.strftime("%Y-%m-%d"), "build_wall_s": round(wall, 1),
                "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
                "sphinx_and_overhead_s": round(wall - sum(chapters.values()), 1)}
