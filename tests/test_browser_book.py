@@ -90,7 +90,7 @@ def test_every_page_loads_offline(browser, book):
         assert path.exists(), f"{name} is in _toc.yml but was not built"
         pg = OfflinePage(browser, path)
         pg.typeset()
-        info = pg.page.evaluate("""() => ({
+        info = pg.page.evaluate(r"""() => ({
             math: document.querySelectorAll('.math').length,
             untypeset: [...document.querySelectorAll('.math')].filter(e => !e.querySelector('mjx-container'))
                          .map(e => e.textContent.slice(0, 80)),
@@ -99,6 +99,11 @@ def test_every_page_loads_offline(browser, book):
             brokenImages: [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src),
             explorersNotDrawn: [...document.querySelectorAll('.safepg-explorer')]
                          .filter(e => !e.querySelector('.safepg-values').textContent).length,
+            // A Markdown table output that was not rendered shows its |---| row as text (after
+            // Sphinx's smart quotes, as an em or en dash).
+            rawMarkdownTables: [...document.querySelectorAll('.cell_output')]
+                         .filter(e => /\|\s*(---|\u2014|\u2013)\s*\|/.test(e.textContent))
+                         .map(e => e.textContent.slice(0, 80)),
         })""")
         bad = {k: v for k, v in info.items() if k != "math" and v}
         errors = [e for e in pg.errors if "favicon" not in e]
