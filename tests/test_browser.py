@@ -8,11 +8,11 @@ explorer's slider redraws values equal to safepg's.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+from browser_pages import OfflinePage
 
 ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
@@ -24,31 +24,7 @@ pytestmark = pytest.mark.browser
 # through Playwright; skipped without it, failed under CI=true) are in tests/conftest.py.
 
 
-class Page:
-    """A page with its console errors and any request that is not a local file."""
-
-    def __init__(self, browser, path: Path):
-        self.page = browser.new_page(viewport={"width": 1200, "height": 1600})
-        self.errors: list[str] = []
-        self.remote: list[str] = []
-        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
-        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
-        self.page.route("**/*", self._route)
-        self.page.goto(path.as_uri())
-        self.page.wait_for_load_state("load")
-
-    def _route(self, route):
-        if route.request.url.startswith("file://"):
-            route.continue_()
-        else:
-            self.remote.append(route.request.url)
-            route.abort()
-
-    def values(self, index: int = 0) -> dict:
-        return json.loads(self.page.locator(".safepg-values").nth(index).text_content())
-
-
-def _check_page(pg: Page, min_images: int) -> None:
+def _check_page(pg: OfflinePage, min_images: int) -> None:
     pg.page.wait_for_selector("mjx-container", state="attached", timeout=20_000)
     assert pg.page.locator("mjx-container").count() > 5
     assert pg.page.locator("img").count() >= min_images
@@ -59,7 +35,7 @@ def _check_page(pg: Page, min_images: int) -> None:
 
 
 def test_intro_renders(browser, book):
-    pg = Page(browser, book / "book" / "intro.html")
+    pg = OfflinePage(browser, book / "book" / "intro.html", height=1600)
     pg.page.wait_for_selector("mjx-container", state="attached", timeout=20_000)
     assert not pg.remote and not pg.errors
 
@@ -67,7 +43,7 @@ def test_intro_renders(browser, book):
 def test_lqg_explorer_matches_safepg(browser, book):
     from safepg.explorers import lqg_explorer
 
-    pg = Page(browser, book / "book" / "preliminaries.html")
+    pg = OfflinePage(browser, book / "book" / "preliminaries.html", height=1600)
     _check_page(pg, min_images=3)
     explorer = pg.page.locator(".safepg-explorer").first
     explorer.scroll_into_view_if_needed()
@@ -101,7 +77,7 @@ def _set(page, name: str, value: str) -> None:
 def test_upsilon_explorer_matches_safepg(browser, book):
     from safepg.explorers import upsilon_explorer
 
-    pg = Page(browser, book / "book" / "adaptive_batch.html")
+    pg = OfflinePage(browser, book / "book" / "adaptive_batch.html", height=1600)
     _check_page(pg, min_images=1)
     assert pg.values()["params"] == {"delta": 0.95, "sigma": 1.0, "g": 30.0, "bound": "bernstein-er"}
     py_explorer = upsilon_explorer()
@@ -125,7 +101,7 @@ def test_batch_size_explorer_matches_stored_runs(browser, book):
     from safepg.experiments import get_experiment, load_experiment
     from safepg.explorers import batch_size_explorer
 
-    pg = Page(browser, book / "book" / "lqg1d.html")
+    pg = OfflinePage(browser, book / "book" / "lqg1d.html", height=1600)
     _check_page(pg, min_images=4)
     exp = get_experiment("table-5.2")
     py = batch_size_explorer(load_experiment(exp, ROOT / "results"), exp.configs)

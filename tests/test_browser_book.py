@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from browser_pages import OfflinePage
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
@@ -52,33 +53,6 @@ def toc_pages() -> list[str]:
 
     walk({k: v for k, v in toc.items() if k != "root"})
     return out
-
-
-class OfflinePage:
-    """A page opened from disk that records console errors and blocks any non-file request."""
-
-    def __init__(self, browser: Any, path: Path, width: int = 1200) -> None:
-        self.page = browser.new_page(viewport={"width": width, "height": 1400})
-        self.errors: list[str] = []
-        self.remote: list[str] = []
-        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
-        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
-        self.page.route("**/*", self._route)
-        self.page.goto(path.as_uri())
-        self.page.wait_for_load_state("load")
-
-    def _route(self, route: Any) -> None:
-        if route.request.url.startswith("file://"):
-            route.continue_()
-        else:
-            self.remote.append(route.request.url)
-            route.abort()
-
-    def typeset(self) -> None:
-        """Wait until MathJax has typeset the page."""
-        self.page.wait_for_function("() => window.MathJax && MathJax.startup && MathJax.startup.promise",
-                                    timeout=20_000)
-        self.page.evaluate("() => MathJax.startup.promise")
 
 
 def test_every_page_loads_offline(browser, book):
