@@ -23,6 +23,18 @@ ScoreAction = Literal["clipped", "raw"]
 ESTIMATORS: tuple[Estimator, ...] = ("reinforce", "gpomdp")
 
 
+def check_estimator(estimator: str) -> None:
+    """Raise ``ValueError("estimator ...")`` unless ``estimator`` is one of :data:`ESTIMATORS`."""
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+
+
+def check_score_action(score_action: str) -> None:
+    """Raise ``ValueError("score_action ...")`` unless it is ``"clipped"`` or ``"raw"``."""
+    if score_action not in ("clipped", "raw"):
+        raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+
+
 def _safe_ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:
     """num / den with 0 where den == 0 (a component whose score is identically 0)."""
     out = np.zeros_like(num)
@@ -101,8 +113,7 @@ def trajectory_scores(
     code did (biased when clipping is active, see SETTINGS.md); ``"raw"`` scores the
     action actually sampled from the policy, which gives an unbiased estimator.
     """
-    if score_action not in ("clipped", "raw"):
-        raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+    check_score_action(score_action)
     actions = batch.actions if score_action == "clipped" else batch.actions_raw
     scores = policy.score(batch.features, actions)
     if batch.mask is not None:
@@ -121,6 +132,5 @@ def gradient_samples(
     scores = trajectory_scores(policy, batch, score_action)
     if estimator == "reinforce":
         return reinforce(scores, batch.rewards, batch.gamma, baseline)
-    if estimator == "gpomdp":
-        return gpomdp(scores, batch.rewards, batch.gamma, baseline)
-    raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+    check_estimator(estimator)
+    return gpomdp(scores, batch.rewards, batch.gamma, baseline)

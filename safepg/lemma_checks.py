@@ -19,6 +19,7 @@ import numpy as np
 from scipy import integrate
 
 from safepg._rng import RNGLike, as_generator
+from safepg.estimators import check_estimator
 
 __all__ = [
     "CheckResult",
@@ -469,8 +470,7 @@ def check_lemma_4_3_3(
     CheckResult
         Violation (range - printed bound) / printed bound (``> 0``: the lemma fails).
     """
-    if estimator not in ("reinforce", "gpomdp"):
-        raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
+    check_estimator(estimator)
     disc = gamma ** np.arange(horizon)  # gamma^(l-1), l = 1..H
 
     def sample(action: float, reward: float) -> float:

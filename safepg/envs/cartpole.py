@@ -59,6 +59,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from safepg._rng import RNGLike, as_generator
+from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
 from safepg.trajectories import Trajectories
 
@@ -344,10 +345,8 @@ class CartPole:
         from safepg.envs._cartpole_kernel import cartpole_gradient_samples
 
         n = self._check_policy_and_n(policy, n)
-        if estimator not in ("reinforce", "gpomdp"):
-            raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
-        if score_action not in ("clipped", "raw"):
-            raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+        check_estimator(estimator)
+        check_score_action(score_action)
         rng = as_generator(rng)
         s0 = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
         z = rng.standard_normal((n, self.horizon, self.action_dim))

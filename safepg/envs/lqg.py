@@ -23,6 +23,7 @@ import numpy as np
 from scipy.linalg import solve_discrete_lyapunov
 
 from safepg._rng import RNGLike, as_generator
+from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
 from safepg.trajectories import Trajectories
 
@@ -307,10 +308,8 @@ class LQG:
         self._check_policy(policy)
         if int(n) != n or n < 1:
             raise ValueError(f"n must be a positive integer, got {n}")
-        if estimator not in ("reinforce", "gpomdp"):
-            raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
-        if score_action not in ("clipped", "raw"):
-            raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
+        check_estimator(estimator)
+        check_score_action(score_action)
         rng = as_generator(rng)
         A, B, Q, R = self._mats
         s0 = rng.uniform(-self.state_bound, self.state_bound, size=(n, self.dim))
