@@ -303,7 +303,7 @@ EXPERIMENTS: dict[str, Experiment] = {
 
 
 def _warm_start_config(name: str) -> RunConfig:
-    exp = EXPERIMENTS[name] if name in EXPERIMENTS else get_experiment(name)
+    exp = get_experiment(name)
     if len(exp.configs) != 1:
         raise ValueError(f"warm_start must name an experiment with one config, {name!r} has {len(exp.configs)}")
     return exp.configs[0]
@@ -311,9 +311,8 @@ def _warm_start_config(name: str) -> RunConfig:
 
 def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
     """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
-    exp = get_experiment(name)
     cfg = _warm_start_config(name)
-    path = run_path(exp, cfg, k, root)
+    path = run_path(get_experiment(name), cfg, k, root)
     rec = _stored(path, cfg)
     if rec is None:
         _run_and_store(cfg, k, path, single_thread=False)
