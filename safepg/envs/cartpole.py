@@ -350,11 +350,11 @@ class CartPole:
         rng = as_generator(rng)
         s0 = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
         z = rng.standard_normal((n, self.horizon, self.action_dim))
+        # The wrapper normalises the argument types (one compiled specialisation).
         return cartpole_gradient_samples(
-            np.ascontiguousarray(policy.gain[0]), float(policy.cov_chol[0, 0]),
-            float(self.pole_length), float(self.cart_mass), float(self.pole_mass), float(self.gravity),
-            float(self.tau), s0, z, float(self.gamma), float(self.action_bound), float(self.x_threshold),
-            float(self.angle_threshold), score_action == "clipped", estimator == "reinforce", bool(baseline))
+            policy.gain[0], policy.cov_chol[0, 0], self.pole_length, self.cart_mass, self.pole_mass, self.gravity,
+            self.tau, s0, z, self.gamma, self.action_bound, self.x_threshold, self.angle_threshold,
+            score_action == "clipped", estimator == "reinforce", baseline)
 
     def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
                       rng: RNGLike = None) -> Trajectories:
