@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+from decimal import Decimal, InvalidOperation
 
 import numpy as np
 
@@ -13,6 +14,49 @@ from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
 
 ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
+
+
+def integer(text: str) -> int:
+    """An integer count as users type it: ``3000000``, ``3_000_000`` or ``3e6``.
+
+    Scientific notation is accepted when it is exactly a whole number (``1.5e3`` is 1500);
+    ``1500.5`` or ``1e-3`` are refused rather than rounded. Parsed as a decimal, so no
+    binary rounding can turn a non-integer into an integer.
+    """
+    try:
+        value = Decimal(text.strip())
+    except InvalidOperation:
+        raise argparse.ArgumentTypeError(f"expected an integer such as 1000000 or 1e6, got {text!r}") from None
+    if not value.is_finite() or value != value.to_integral_value():
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
+    if value.adjusted() > 18:  # int() of 1e999999999 would build a billion-digit number
+        raise argparse.ArgumentTypeError(f"expected at most 19 digits, got {text!r}")
+    return int(value)
+
+
+def positive_integer(text: str) -> int:
+    """argparse type: an :func:`integer` >= 1 (seeds, budgets, batch sizes)."""
+    value = integer(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}")
+    return value
+
+
+def nonnegative_integer(text: str) -> int:
+    """argparse type: an :func:`integer` >= 0 (a random seed)."""
+    value = integer(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}")
+    return value
+
+
+def jobs_integer(text: str) -> int:
+    """argparse type: joblib's n_jobs, a number of workers or -1 for all cores (-2 all but one)."""
+    value = integer(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"must be a number of parallel workers (>= 1) or negative "
+                                         f"(-1: all cores, -2: all but one), got {text!r}")
+    return value
 
 
 def _learn_parser(sub: argparse._SubParsersAction) -> None:
@@ -25,16 +69,16 @@ def _learn_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--delta", type=float, default=0.95)
     p.add_argument("--sigma", type=float, default=1.0)
     p.add_argument("--theta0", type=float, nargs="+", default=[0.0])
-    p.add_argument("--budget", type=int, default=30_000_000, help="total trajectories")
-    p.add_argument("--n-min", type=int, default=100)
-    p.add_argument("--n-max", type=int, default=500_000)
+    p.add_argument("--budget", type=positive_integer, default=30_000_000, help="total trajectories (3e7 is fine)")
+    p.add_argument("--n-min", type=positive_integer, default=100)
+    p.add_argument("--n-max", type=positive_integer, default=500_000)
     p.add_argument("--fixed-alpha", type=float, help="vanilla PG with this step size")
-    p.add_argument("--fixed-n", type=int, help="vanilla PG with this batch size")
+    p.add_argument("--fixed-n", type=positive_integer, help="vanilla PG with this batch size")
     p.add_argument("--step", choices=["scalar", "coordinate"], default="scalar",
                    help="vanilla PG: update all components or only the largest")
     p.add_argument("--score-action", choices=["clipped", "raw"], default="clipped",
                    help="score the clipped action (authors' code) or the sampled one (unbiased)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=nonnegative_integer, default=0)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -69,7 +113,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         experiments = None  # type: ignore[assignment]
     if experiments is not None:
         experiments.add_parsers(sub)
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # a usage error (argparse printed it, exit status 2) or --help
+        return exc.code if isinstance(exc.code, int) else int(exc.code is not None)
     try:
         if args.command == "learn":
             out = _run_learn(args)
@@ -78,6 +125,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, TypeError) as err:
         print(f"safepg: error: {err}", file=sys.stderr)
         return 2
+    except Exception as err:
+        if experiments is not None and isinstance(err, experiments.NothingStoredError):
+            print(f"safepg: {err}", file=sys.stderr)
+            return 1
+        raise
     if out is not None:
         json.dump(out, sys.stdout, indent=None if args.command == "learn" else 1)
         sys.stdout.write("\n")

@@ -9,6 +9,12 @@ tqdm progress, and writes each finished run atomically to
 version as metadata. An interrupted campaign resumes where it stopped; a run whose
 config or library version changed is recomputed, the others are not.
 
+Workers only compute: each returns its :class:`LearningRecord` to the calling process,
+which writes it to the store as it arrives. Workers on other machines therefore need no
+shared filesystem, and a warm start is read from the store here and sent with the task.
+Two runners on one results folder both compute the missing runs and write identical
+files; neither can corrupt the other's (see :func:`_save_atomic`).
+
 The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
 """
 
@@ -18,7 +24,11 @@ import argparse
 import hashlib
 import json
 import os
+import re
+import socket
+import sys
 import tempfile
+import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -73,17 +83,26 @@ class RunConfig:
         """Independent stream for seed index k of this configuration."""
         return np.random.SeedSequence([k, int(self.key(), 16) % 2**63])
 
-    def run(self, k: int, progress: bool = False, root: Path | None = None) -> LearningRecord:
+    def run(self, k: int, progress: bool = False, root: Path | None = None,
+            theta0: np.ndarray | None = None) -> LearningRecord:
         """Run seed k.
 
         With ``warm_start`` the run starts from the final theta of seed k of that
-        experiment (loaded from ``root``, computed first if missing): the cart-pole
-        adaptation of Section 5.3 starts from each seed's own baseline policy.
+        experiment: the cart-pole adaptation of Section 5.3 starts from each seed's own
+        baseline policy. Pass that policy as ``theta0`` (what :func:`run_experiment`
+        does, so a remote worker never reads the store); without it, it is loaded from
+        ``root`` (computed first if missing).
         """
         env = make_env(self.env)
-        theta0 = np.asarray(self.theta0, dtype=float)
-        if self.warm_start is not None:
+        if theta0 is not None:
+            if self.warm_start is None:
+                raise ValueError(f"theta0 is only for warm-started configs, {self.name!r} starts from "
+                                 f"{self.theta0}")
+            theta0 = np.asarray(theta0, dtype=float)
+        elif self.warm_start is not None:
             theta0 = warm_start_theta(self.warm_start, k, root)
+        else:
+            theta0 = np.asarray(self.theta0, dtype=float)
         common = dict(estimator=self.estimator, baseline=self.baseline, bound=self.bound,
                       delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
                       score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
@@ -322,9 +341,8 @@ def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
     path = run_path(get_experiment(name), cfg, k, root)
     rec = _stored(path, cfg)
     if rec is None:
-        _run_and_store(cfg, k, path, single_thread=False)
-        rec = _stored(path, cfg)
-        assert rec is not None
+        rec = _compute(cfg, k, None, single_thread=False)
+        _save_atomic(rec, path)
     return rec.theta_final
 
 
@@ -336,6 +354,10 @@ def get_experiment(name: str) -> Experiment:
 
 def scaled(exp: Experiment, seeds: int | None = None, budget: int | None = None) -> Experiment:
     """The same experiment with fewer seeds or another trajectory budget."""
+    for name, value in (("seeds", seeds), ("budget", budget)):
+        # bool is an int, numpy integers are not: accept the latter, refuse the former.
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1):
+            raise ValueError(f"{name} must be a positive integer, got {value!r}")
     configs = exp.configs if budget is None else tuple(replace(c, budget=budget) for c in exp.configs)
     return replace(exp, configs=configs, seeds=exp.seeds if seeds is None else seeds)
 
@@ -362,28 +384,94 @@ def _stored(path: Path, cfg: RunConfig) -> LearningRecord | None:
     return rec
 
 
+#: Suffix of a run file being written. Its name is ``<stem>~<host>~<pid>~<random>.tmp.npz``:
+#: the writer's host and process id tell a later runner whether the writer is still alive.
+TEMP_SUFFIX = ".tmp.npz"
+#: A temporary file whose writer cannot be checked (another host, or the unnamed files of
+#: older versions) is stale after this long: writing one run file takes well under a second.
+TEMP_MAX_AGE = 3600.0
+_TEMP_NAME = re.compile(r"^(?P<stem>[^~]+)~(?P<host>[^~]+)~(?P<pid>\d+)~[^~]*" + re.escape(TEMP_SUFFIX) + "$")
+
+
 def _save_atomic(rec: LearningRecord, path: Path) -> None:
+    """Write ``rec`` to ``path`` so readers see the old file or the whole new one, never half.
+
+    The record goes to a temporary file in the same folder, renamed over ``path`` when
+    complete. A writer killed mid-save (SIGKILL, power loss) leaves that temporary file
+    behind, named after its host and process id so that :func:`remove_stale_temp_files`
+    can tell it from one a live runner is still writing.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{path.stem}~{socket.gethostname()}~{os.getpid()}~",
+                               suffix=TEMP_SUFFIX)
     os.close(fd)
     try:
         rec.save(tmp)
-        os.replace(tmp, path)  # readers see the old file or the whole new one, never half
+        os.replace(tmp, path)  # atomic on POSIX and Windows within one filesystem
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
 
 
-def _run_and_store(cfg: RunConfig, k: int, path: Path, single_thread: bool, root: Path | None = None) -> str:
+def _pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` of this host is running (a zombie counts as dead)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by another user
+        return True
+    try:  # Linux: a killed child not yet reaped by its parent still answers kill(pid, 0)
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return True
+
+
+def remove_stale_temp_files(folder: Path) -> list[Path]:
+    """Delete the temporary run files under ``folder`` whose writer is dead; return them.
+
+    A file written by a process of this host is stale when that process no longer runs;
+    one from another host (a results folder shared over the network) or without a writer
+    in its name (older versions) when it is older than :data:`TEMP_MAX_AGE` seconds.
+    A live runner's file is never touched, so two runners can share a folder. A dead
+    writer's id reused by a new process only delays the removal to a later run.
+    """
+    removed = []
+    host, now = socket.gethostname(), time.time()
+    for tmp in sorted(folder.rglob(f"*{TEMP_SUFFIX}")) if folder.is_dir() else ():
+        m = _TEMP_NAME.match(tmp.name)
+        try:
+            if m is not None and m["host"] == host:
+                stale = not _pid_alive(int(m["pid"]))
+            else:
+                stale = now - tmp.stat().st_mtime > TEMP_MAX_AGE
+            if stale:
+                tmp.unlink()
+                removed.append(tmp)
+        except FileNotFoundError:  # its writer renamed or removed it meanwhile
+            continue
+    return removed
+
+
+def _compute(cfg: RunConfig, k: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
+    """Run seed k of ``cfg`` on a worker and return the record (the caller stores it)."""
     if single_thread:  # joblib already uses every core; numba threads would oversubscribe
         import numba
 
         numba.set_num_threads(1)
-    rec = cfg.run(k, root=root)
+    rec = cfg.run(k, theta0=theta0)
     rec.config["run_key"] = cfg.key()
     rec.config["config_name"] = cfg.name
-    _save_atomic(rec, path)
-    return str(path)
+    return rec
+
+
+def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
+                  single_thread: bool) -> tuple[int, LearningRecord]:
+    """:func:`_compute` tagged with the task's index: results arrive in any order."""
+    return i, _compute(cfg, k, theta0, single_thread)
 
 
 def run_experiment(
@@ -396,24 +484,42 @@ def run_experiment(
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) of ``exp`` and return all records by config name.
 
-    Finished runs are loaded, never recomputed; each new run is saved as soon as it
-    finishes, so an interrupted campaign loses nothing already computed.
+    Finished runs are loaded, never recomputed. The runs go to joblib's current backend
+    (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
+    worker returns its record and this process saves it as soon as it arrives, so an
+    interrupted campaign loses nothing already computed and remote workers need no
+    access to ``root``. ``jobs`` follows joblib: a positive count, or -1 for every core
+    (-2 all but one, ...).
     """
     from joblib import Parallel, delayed, effective_n_jobs
 
+    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
+        raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
     exp = get_experiment(exp) if isinstance(exp, str) else exp
     exp = scaled(exp, seeds, budget)
+    # Files a killed runner was writing; a live runner's are kept.
+    remove_stale_temp_files((root or results_dir()) / exp.name)
     # Starting policies first (in parallel), so no two workers compute the same one.
+    starts: dict[str, list[np.ndarray]] = {}
     for dep in sorted({c.warm_start for c in exp.configs if c.warm_start is not None}):
-        run_experiment(dep, seeds=exp.seeds, jobs=jobs, root=root, progress=progress)
+        dep_cfg = _warm_start_config(dep)
+        dep_recs = run_experiment(dep, seeds=exp.seeds, jobs=jobs, root=root, progress=progress)[dep_cfg.name]
+        starts[dep] = [r.theta_final for r in dep_recs]
     todo = [(c, k) for c in exp.configs for k in range(exp.seeds)
             if _stored(run_path(exp, c, k, root), c) is None]
+    # Largest budgets first (the budget is the cost we know before running): a long run
+    # dispatched last would leave the other workers idle at the end. Stable, so equal
+    # budgets keep the table's order.
+    todo.sort(key=lambda ck: -ck[0].budget)
     if todo:
         n_jobs = effective_n_jobs(jobs)
-        tasks = (delayed(_run_and_store)(c, k, run_path(exp, c, k, root), n_jobs > 1, root) for c, k in todo)
-        # Longest runs first keeps both cores busy to the end.
+        tasks = (delayed(_compute_task)(i, c, k, None if c.warm_start is None else starts[c.warm_start][k],
+                                        n_jobs > 1)
+                 for i, (c, k) in enumerate(todo))
         with tqdm(total=len(todo), desc=exp.name, unit="run", disable=not progress) as bar:
-            for _ in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+            for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+                c, k = todo[i]
+                _save_atomic(rec, run_path(exp, c, k, root))
                 bar.update()
     return load_experiment(exp, root)
 
@@ -480,22 +586,35 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
 
 
 # ------------------------------------------------------------------ command line
+class NothingStoredError(LookupError):
+    """``report`` found no stored run of the experiment (the CLI exits with status 1)."""
+
+
 def add_parsers(sub: argparse._SubParsersAction) -> None:
+    from safepg.cli import jobs_integer, positive_integer
+
     p = sub.add_parser("list", help="name every experiment")
     p.set_defaults(func=_cmd_list)
     p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")
     p.add_argument("name")
-    p.add_argument("--seeds", type=int, help="number of seeds (default: the thesis's)")
-    p.add_argument("--budget", type=int, help="trajectories per run (default: the thesis's)")
-    p.add_argument("--jobs", type=int, default=-1, help="parallel jobs (default: all cores)")
+    p.add_argument("--seeds", type=positive_integer, help="number of seeds (default: the thesis's)")
+    p.add_argument("--budget", type=positive_integer, help="trajectories per run, e.g. 2e5 (default: the thesis's)")
+    p.add_argument("--jobs", type=jobs_integer, default=-1,
+                   help="parallel workers; -1 (default) all cores, -2 all but one")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=_cmd_run)
     p = sub.add_parser("report", help="summarise an experiment's stored runs")
     p.add_argument("name")
-    p.add_argument("--seeds", type=int)
-    p.add_argument("--budget", type=int)
+    p.add_argument("--seeds", type=positive_integer)
+    p.add_argument("--budget", type=positive_integer)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_report)
+
+
+def _run_command(args: argparse.Namespace) -> str:
+    """The ``run`` command that computes what ``report`` with these arguments reads."""
+    extra = "".join(f" --{k} {getattr(args, k)}" for k in ("seeds", "budget") if getattr(args, k) is not None)
+    return f"python -m safepg run {args.name}{extra}"
 
 
 def _cmd_list(args: argparse.Namespace) -> None:
@@ -512,6 +631,14 @@ def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
 def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
     exp = scaled(get_experiment(args.name), args.seeds, args.budget)
     out = report(exp)
+    # The store is keyed by settings, so "nothing stored" often means other --seeds/--budget.
+    stored, total = sum(r["seeds"] for r in out["configs"]), len(exp.configs) * exp.seeds
+    if stored == 0:
+        raise NothingStoredError(f"nothing stored for {exp.name} with these settings under {results_dir()}; "
+                                 f"compute it first with: {_run_command(args)}")
+    if stored < total:
+        print(f"safepg: note: {stored} of {total} runs of {exp.name} stored; the rest with: "
+              f"{_run_command(args)}", file=sys.stderr)
     if args.json:
         return out
     for row in out["configs"]:
