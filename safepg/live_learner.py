@@ -1,0 +1,499 @@
+r"""The live batch-size explorer: Algorithm 4.1 reruns in the reader's browser.
+
+:func:`live_batch_size_explorer` returns an :class:`~safepg.explorer.Explorer` whose page
+half runs the JavaScript learner ``safepg/static/learner.js`` (Algorithm 4.1 and vanilla
+policy gradient on ``LQG.thesis_1d()``, the same algorithm as :mod:`safepg.learning`) in
+a Web Worker created from an inline Blob, so it needs no kernel, no network and no file
+beside the page (it works from ``file://``). Every control move cancels the running
+worker and starts a new one; long runs are drawn as they progress.
+
+The Python twin ``compute_py`` runs :func:`safepg.learning.adaptive_pg` and
+:func:`~safepg.learning.vanilla_pg` with the same settings and returns the same structure
+(:meth:`LiveLearnerExplorer.interactive` draws it with ipywidgets). The two use different
+random-number generators (numpy's PCG64 here, xoshiro128** in the page), so for one seed
+their curves differ as two seeds do; tests/test_learner_js.py shows that they agree in
+distribution.
+
+Where the controls match one of the stored Table 5.2 runs (sigma = 1, baseline on and the
+estimator, bound, delta and score of a stored configuration) the seed mean of that run,
+computed by safepg when the book was built, is drawn beside the live curve.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import html
+import json
+from collections.abc import Mapping, Sequence
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from safepg import plotting
+from safepg.analysis import by_iteration, mean_band, performance_on_grid
+from safepg.envs.lqg import LQG
+from safepg.explorer import _RUNTIME_JS, Explorer, Plot, Select, Slider
+from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+
+#: Budgets offered (trajectories); the stored runs are embedded up to the largest.
+BUDGETS = (10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000)
+#: Points of each drawn curve (iterations or trajectory counts): enough for a 640 px plot.
+CURVE_POINTS = 600
+#: Significant digits of the embedded stored curves: what the page can show, and few
+#: enough that the embedded JSON does not depend on the machine's floating-point library.
+DIGITS = 6
+BOUND_CHOICES = (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"), ("hoeffding-er", "Hoeffding (e.r.)"),
+                 ("bernstein", "Bernstein"), ("bernstein-er", "Bernstein (e.r.)"))
+TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in your browser"
+
+
+@lru_cache(maxsize=1)
+def learner_js() -> str:
+    """The JavaScript learner shipped in the package (``safepg/static/learner.js``)."""
+    return resources.files("safepg").joinpath("static/learner.js").read_text(encoding="utf-8")
+
+
+def _round(values: Any, digits: int = DIGITS) -> list[float | None]:
+    """Floats rounded to ``digits`` significant digits (None for NaN), for embedding."""
+    out: list[float | None] = []
+    for v in np.asarray(values, dtype=float).ravel():
+        out.append(float(f"{v:.{digits}g}") if np.isfinite(v) else None)
+    return out
+
+
+def task_data(env: LQG | None = None) -> dict[str, Any]:
+    """The 1-D LQG settings and bound constants the JavaScript learner runs with."""
+    env = LQG.thesis_1d() if env is None else env
+    if env.dim != 1:
+        raise ValueError(f"env must be a one-dimensional LQG, got dim={env.dim}")
+    A, B, Q, R = (float(np.asarray(getattr(env, k), dtype=float).reshape(-1)[0]) for k in "ABQR")
+    return {"gamma": env.gamma, "H": env.horizon, "bs": env.state_bound, "ba": env.action_bound, "clip": env.clip,
+            "A": A, "B": B, "Q": Q, "Rc": R, "R": env.reward_bound, "M": env.feature_bound,
+            "Avol": env.action_volume, "Abar": env.action_bound}
+
+
+def _thin(n: int, points: int = CURVE_POINTS) -> np.ndarray:
+    """Indices of at most ``points`` evenly spread entries of a length-n curve (first and last kept)."""
+    if n <= points:
+        return np.arange(n)
+    return np.unique(np.floor(np.arange(points) * (n - 1) / (points - 1) + 0.5).astype(np.int64))
+
+
+def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> dict[str, Any]:
+    """The embedded curves of one stored configuration: seed means up to the largest budget."""
+    top = BUDGETS[-1]
+    starts = [np.concatenate([[0], np.cumsum(r.batch_size)[:-1]]) for r in recs]
+    cut = [int(np.searchsorted(s, top)) for s in starts]  # iterations that start before the largest budget
+    n = mean_band(by_iteration(recs, "batch_size"))[0]
+    a = mean_band(by_iteration(recs, "alpha"))[0]
+    start = np.full((len(recs), max(cut)), np.nan)
+    for i, (s, k) in enumerate(zip(starts, cut)):
+        start[i, :k] = s[:k]
+    start_mean = np.nanmean(start, axis=0)
+    keep = _thin(max(cut))
+    per_budget = {}
+    for B in BUDGETS:
+        ups, its = [], []
+        for r, s in zip(recs, starts):
+            # Trajectories 1..B: each batch weighs by its part inside the first B.
+            w = np.clip(B - s, 0, r.batch_size)
+            ups.append(float(w @ r.J_hat / w.sum()))
+            its.append(int(np.count_nonzero(s < B)))
+        per_budget[str(B)] = {"upsilon_bar": _round([np.mean(ups)])[0], "iterations": float(np.mean(its))}
+    return {"estimator": cfg.estimator, "bound": cfg.bound + ("-er" if cfg.empirical_range else ""),
+            "delta": cfg.delta, "score": cfg.score_action, "seeds": len(recs), "name": cfg.name,
+            "iteration": (keep + 1).tolist(), "start": _round(start_mean[keep]),
+            "batch_size": _round(n[keep]), "alpha": _round(a[keep]),
+            "J": _round(mean_band(performance_on_grid(recs, grid))[0]), "budgets": per_budget}
+
+
+def _matches_1d_table(cfg: Any) -> bool:
+    """A stored configuration the live learner can rerun: Algorithm 4.1 on the 1-D LQG from
+    theta_0 = 0, sigma = 1, with the default batch limits, range and a long enough budget."""
+    return (getattr(cfg, "algorithm", None) == "adaptive" and cfg.env == "lqg1d" and tuple(cfg.theta0) == (0.0,)
+            and cfg.sigma == 1.0 and cfg.baseline and cfg.n_min == 100 and cfg.n_max == 500_000
+            and cfg.theoretical_range is None and cfg.budget >= BUDGETS[-1] and cfg.warm_start is None)
+
+
+def overlay_key(p: Mapping[str, Any]) -> str:
+    """Key of the stored run matching the controls ``p`` (also built by the page)."""
+    return f"{p['estimator']}-{p['bound']}-delta={float(p['delta']):g}-{p['score']}"
+
+
+class LiveLearnerExplorer(Explorer):
+    """An :class:`~safepg.explorer.Explorer` whose page runs the JavaScript learner in a
+    Web Worker (see the module docstring); ``compute_js`` is unused."""
+
+    def to_html(self) -> str:
+        """The self-contained HTML + JavaScript block (learner, worker and plots inline)."""
+        spec = json.dumps(self._spec(), separators=(",", ":"), allow_nan=False)
+        learner = json.dumps(learner_js())
+        uid = "safepg-live-" + hashlib.sha1((self.title + spec + learner).encode()).hexdigest()[:10]
+        rows = []
+        for c in self.controls:
+            style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
+            if isinstance(c, Slider):
+                rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
+                            f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
+                            f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')
+            else:
+                opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
+                               f"{html.escape(lbl)}</option>" for v, lbl in c.options)
+                rows.append(f'<label {style}>{html.escape(c.label)} <select data-param="{c.name}">{opts}</select>'
+                            "</label>")
+        svgs = "".join(f'<svg data-plot="{p.id}" role="img" aria-label="{html.escape(p.ylabel)} over '
+                       f'{html.escape(p.xlabel)}" style="width:100%;max-width:640px;height:auto;display:block">'
+                       "</svg>" for p in self.plots)
+        return (
+            f'<div class="safepg-explorer safepg-live" id="{uid}" style="border:1px solid rgba(127,127,127,.4);'
+            f'border-radius:6px;padding:0.8em;margin:1em 0">'
+            f'<div style="font-weight:600;margin-bottom:0.4em">{html.escape(self.title)}</div>'
+            f'{"".join(rows)}'
+            '<div class="safepg-status" style="font-size:0.85em;opacity:0.8;margin:0.2em 0"></div>'
+            f'{svgs}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
+            '<pre class="safepg-values" hidden></pre>'
+            f"<script>(function(){{{_RUNTIME_JS}{_LIVE_JS}"
+            f"const spec={spec};const learnerSrc={learner};"
+            f'safepgLiveLearner(document.getElementById("{uid}"),spec,learnerSrc);}})();</script></div>'
+        )
+
+    def __repr__(self) -> str:
+        return f"LiveLearnerExplorer({self.title!r})"
+
+    def interactive(self) -> Any:
+        """ipywidgets version for a live kernel: the same controls, each change reruns
+        :mod:`safepg.learning` (``compute_py``) and draws it with matplotlib. Sliders act
+        on release, since each change is a full learning run."""
+        import ipywidgets as w
+        import matplotlib.pyplot as plt
+
+        kw: dict[str, Any] = {}
+        for c in self.controls:
+            if isinstance(c, Slider):
+                kw[c.name] = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label,
+                                           continuous_update=False)
+            else:
+                kw[c.name] = w.Dropdown(options=[(lbl, v) for v, lbl in c.options], value=c.value,
+                                        description=c.label)
+
+        def draw(**p: Any) -> None:
+            res = self.compute_py(p)
+            fig, axes = plt.subplots(1, len(self.plots), figsize=(5 * len(self.plots), 3.6), squeeze=False)
+            for ax, spec in zip(axes[0], self.plots):
+                for s in res["plots"][spec.id]["series"]:
+                    ax.plot(s["x"], s["y"], color=s.get("color"), linestyle="--" if s.get("dash") else "-",
+                            label=s.get("label"))
+                ax.set_xscale("log" if spec.xlog else "linear")
+                ax.set_yscale("log" if spec.ylog else "linear")
+                ax.set_xlabel(spec.xlabel)
+                ax.set_ylabel(spec.ylabel)
+                ax.legend(fontsize="small")
+            fig.tight_layout()
+            plt.show()
+            print(res.get("text", ""))
+
+        return w.interactive(draw, **kw)
+
+
+# The page half. safepgPlot and safepgTicks come from safepg.explorer's runtime; the
+# learner source is a string so the worker can be built from a Blob (no file, no network).
+_LIVE_JS = r"""
+const SAFEPG_WORKER_GLUE = `
+self.onmessage = function (e) {
+  const msg = e.data;
+  try {
+    const driver = new safepgLearner.Driver(msg);
+    let first = true;
+    while (!driver.done) {
+      const parts = driver.advance(first ? 15 : msg.every);
+      first = false;
+      self.postMessage({type: driver.done ? "done" : "progress", job: msg.job, parts: parts});
+    }
+  } catch (err) {
+    self.postMessage({type: "error", job: msg.job, message: String((err && err.message) || err)});
+  }
+};`;
+function safepgLiveThin(n, points) {
+  if (n <= points) { const o = []; for (let i = 0; i < n; i++) o.push(i); return o; }
+  const o = [];
+  for (let i = 0; i < points; i++) { const k = Math.floor(i * (n - 1) / (points - 1) + 0.5); if (!o.length || o[o.length - 1] !== k) o.push(k); }
+  return o;
+}
+function safepgLiveSummary(r) {
+  // safepg.learning.LearningRecord's summary of a (possibly partial) record.
+  const I = r.batchSize.length;
+  let tot = 0, w = 0, up = 0;
+  for (let i = 0; i < I; i++) { tot += r.batchSize[i]; w += r.batchSize[i] * r.Jhat[i]; if (r.J[i + 1] - r.J[i] >= 0) up++; }
+  const Jat = {};
+  let end = 0, i = 0;
+  for (const T of [100000, 1000000, 3000000]) {
+    if (T > tot) continue;
+    while (end + r.batchSize[i] < T) { end += r.batchSize[i]; i++; }
+    Jat[String(T)] = r.J[i];
+  }
+  return {iterations: I, trajectories: tot, upsilon_bar: I ? w / tot : null, improvement_ratio: I ? up / I : null,
+          J_final: r.J[I], theta_final: r.theta[I], J_at: Jat, first_batches: r.batchSize.slice(0, 3),
+          done: r.done, diverged: r.diverged};
+}
+function safepgLiveResult(p, st, data) {
+  // The same structure as compute_py: plots (series), values, text.
+  const plots = {N: {series: []}, J: {series: []}, alpha: {series: []}};
+  const values = {done: st.done, worker: st.worker, elapsed_ms: st.elapsed, run_ms: {}};
+  const key = `${p.estimator}-${p.bound}-delta=${+p.delta}-${p.score}`;
+  const run = (p.sigma === 1 && p.baseline === "on") ? data.runs[key] : undefined;
+  const B = +p.budget;
+  if (run) {
+    const its = [], ns = [], as = [];
+    for (let i = 0; i < run.iteration.length; i++) {
+      if (run.start[i] === null || run.start[i] >= B) break;
+      its.push(run.iteration[i]); ns.push(run.batch_size[i]); as.push(run.alpha[i]);
+    }
+    const gx = [], gy = [];
+    for (let i = 0; i < data.grid.length && data.grid[i] <= B; i++) { gx.push(data.grid[i]); gy.push(run.J[i]); }
+    const label = `stored safepg run (${run.seeds} seeds)`, thin = {color: data.muted, dash: true};
+    plots.N.series.push({label: label, x: its, y: ns, ...thin});
+    plots.J.series.push({label: label, x: gx, y: gy, ...thin});
+    plots.alpha.series.push({label: label, x: its, y: as, ...thin});
+    values.thesis = {found: true, key: key, name: run.name, ...run.budgets[String(B)]};
+  } else values.thesis = {found: false, key: key};
+  for (const name of ["adaptive", "vanilla"]) {
+    const r = st.runs[name];
+    if (!r) { values[name] = null; continue; }
+    const I = r.batchSize.length;
+    const style = name === "adaptive" ? {color: data.colors[p.bound], dash: p.estimator === "reinforce"}
+                                      : {color: data.vanilla_color, dash: false};
+    const label = name === "adaptive" ? "Algorithm 4.1 (live)" : `vanilla, N = ${p.vanilla_n}, alpha = ${p.vanilla_alpha}`;
+    const keep = safepgLiveThin(I, data.points);
+    plots.N.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.batchSize[i]), ...style});
+    plots.alpha.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.alpha[i]), ...style});
+    // J of the policy that generated trajectory T (Figures 5.1-5.2), on a grid of T.
+    const gx = [], gy = [];
+    let end = 0, i = 0;
+    for (let k = 0; k < data.points; k++) {
+      const T = Math.max(1, Math.round(1 + k * (B - 1) / (data.points - 1)));
+      if (T > r.used) break;
+      while (i < I && end + r.batchSize[i] < T) { end += r.batchSize[i]; i++; }
+      gx.push(T); gy.push(r.J[Math.min(i, I)]);
+    }
+    plots.J.series.push({label: label, x: gx, y: gy, ...style});
+    values[name] = safepgLiveSummary(r);
+    values.run_ms[name] = r.ms;
+  }
+  const f = (v, d) => (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d);
+  const line = (name, v) => v ? `${name}: ${v.iterations} iterations, ${v.trajectories} trajectories, ` +
+    `Upsilon-bar ${f(v.upsilon_bar, 4)}, improvement ratio ${f(100 * v.improvement_ratio, 2)}%, ` +
+    `J ${f(v.J_final, 3)} at theta ${f(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}` : "";
+  let text = line("Algorithm 4.1", values.adaptive);
+  if (values.vanilla) text += "<br>" + line("vanilla PG", values.vanilla);
+  text += "<br>" + (values.thesis.found
+    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${f(values.thesis.upsilon_bar, 4)}`
+    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, delta in {0.05, 0.25, 0.5, 0.75, 0.95})");
+  return {plots: plots, values: values, text: text};
+}
+function safepgLiveLearner(root, spec, learnerSrc) {
+  const inputs = root.querySelectorAll("[data-param]");
+  const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
+  const data = spec.data;
+  let url = null, worker = null, job = 0, st = null, pending = false, local = null;
+  try { url = URL.createObjectURL(new Blob([learnerSrc, SAFEPG_WORKER_GLUE], {type: "text/javascript"})); }
+  catch (e) { url = null; }
+  function params() {
+    const p = {};
+    inputs.forEach(inp => { p[inp.dataset.param] = inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value); });
+    return p;
+  }
+  function configs(p) {
+    const common = {sigma: p.sigma, estimator: p.estimator, baseline: p.baseline === "on", score: p.score,
+                    budget: +p.budget, seed: Math.round(p.seed), theta0: 0};
+    const b = p.bound.replace("-er", "");
+    const runs = [{name: "adaptive", cfg: {...common, algorithm: "adaptive", bound: b, delta: p.delta,
+                                           empiricalRange: p.bound.endsWith("-er"), nMin: 100, nMax: 500000, stream: 0}}];
+    if (p.vanilla_n !== "off")
+      runs.push({name: "vanilla", cfg: {...common, algorithm: "vanilla", batchSize: +p.vanilla_n,
+                                        alpha: +p.vanilla_alpha, stream: 1}});
+    return runs;
+  }
+  function draw() {
+    pending = false;
+    const res = safepgLiveResult(st.p, st, data);
+    for (const plot of spec.plots)
+      safepgPlot(root.querySelector(`svg[data-plot="${plot.id}"]`), plot, res.plots[plot.id]);
+    root.querySelector(".safepg-text").innerHTML = res.text;
+    const a = st.runs.adaptive;
+    statusEl.textContent = st.error ? `error: ${st.error}` : st.done
+      ? `done in ${(st.elapsed / 1000).toFixed(2)} s (${st.worker ? "Web Worker" : "page thread"})`
+      : `running: ${a ? a.used : 0} of ${st.p.budget} trajectories...`;
+    valuesEl.textContent = JSON.stringify({params: st.p, job: st.job, result: res});
+  }
+  function schedule() { if (!pending) { pending = true; setTimeout(draw, 0); } }
+  function receive(msg) {
+    if (!st || msg.job !== st.job) return;  // a cancelled run's late message
+    if (msg.type === "error") { st.error = msg.message; st.done = true; schedule(); return; }
+    for (const part of msg.parts) {
+      let r = st.runs[part.name];
+      if (!r) r = st.runs[part.name] = {batchSize: [], alpha: [], eps: [], Jhat: [], grad: [],
+                                        theta: [part.theta0], J: [part.J0]};
+      for (const k of ["batchSize", "alpha", "eps", "Jhat", "grad", "theta", "J"])
+        for (const v of part[k]) r[k].push(v);
+      r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms;
+    }
+    st.elapsed = performance.now() - st.t0;
+    if (msg.type === "done") { st.done = true; if (worker) { worker.terminate(); worker = null; } }
+    schedule();
+  }
+  function runLocally(msg) {
+    // No Web Worker (a browser that refuses Blob workers): slices of the page's own thread.
+    const L = new Function(learnerSrc + "\nreturn safepgLearner;")();
+    const driver = new L.Driver(msg), mine = msg.job;
+    local = mine;
+    (function slice() {
+      if (local !== mine) return;  // cancelled by a newer run
+      const parts = driver.advance(25);
+      receive({type: driver.done ? "done" : "progress", job: mine, parts: parts});
+      if (!driver.done) setTimeout(slice, 0);
+    })();
+  }
+  function start() {
+    job += 1; local = null;
+    if (worker) { worker.terminate(); worker = null; }  // cancel the run in flight
+    const p = params();
+    inputs.forEach(inp => {
+      const out = root.querySelector(`[data-show="${inp.dataset.param}"]`);
+      if (out) out.textContent = inp.value;
+    });
+    const msg = {job: job, task: data.task, every: 80, runs: configs(p)};
+    st = {job: job, p: p, runs: {}, done: false, elapsed: 0, t0: performance.now(), worker: false, error: null};
+    if (url && typeof Worker !== "undefined") {
+      try {
+        worker = new Worker(url);
+        worker.onmessage = e => receive(e.data);
+        worker.onerror = e => { e.preventDefault(); if (worker) worker.terminate(); worker = null; st.worker = false; runLocally(msg); };
+        worker.postMessage(msg);
+        st.worker = true;
+      } catch (e) { worker = null; runLocally(msg); }
+    } else runLocally(msg);
+    draw();
+  }
+  inputs.forEach(inp => inp.addEventListener("input", start));
+  start();
+}
+"""
+
+
+def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | None = None,
+                             configs: Sequence[Any] = (), points: int = 300) -> LiveLearnerExplorer:
+    """Algorithm 4.1 (and vanilla PG beside it) rerun live on the 1-D LQG for any delta,
+    sigma, bound, estimator, baseline, score, budget and seed.
+
+    Parameters
+    ----------
+    records : stored runs by configuration name (e.g. ``run_experiment("table-5.2")``), or None
+    configs : the :class:`~safepg.experiments.RunConfig` of those runs; those that the
+        learner can rerun (Algorithm 4.1, 1-D LQG, theta_0 = 0, sigma = 1, baseline on)
+        are embedded as overlays, their seed means rounded to 6 significant digits
+    points : trajectory counts at which the stored J curves are embedded (log-spaced up
+        to the largest budget, plus a linear part so every budget's plot has points)
+
+    Returns
+    -------
+    LiveLearnerExplorer
+        Renders in the page (no kernel); ``.interactive()`` and ``compute_py`` run safepg.
+    """
+    env = LQG.thesis_1d()
+    task = task_data(env)
+    top = BUDGETS[-1]
+    grid = np.unique(np.concatenate([np.geomspace(1, top, points // 2), np.linspace(1, top, points - points // 2)])
+                     .round().astype(np.int64))
+    runs: dict[str, Any] = {}
+    for c in configs:
+        recs = (records or {}).get(c.name) or []
+        if not recs or not _matches_1d_table(c):
+            continue
+        run = _stored_run(c, recs, grid)
+        runs[overlay_key(run)] = run
+    style = plotting.style_table()
+    data = {"task": task, "grid": grid.tolist(), "runs": runs, "points": CURVE_POINTS,
+            "muted": plotting.MUTED, "vanilla_color": "#444444",
+            "colors": {k: v["color"] for k, v in style["bounds"].items()}}
+
+    def compute_py(p: Mapping[str, Any]) -> dict[str, Any]:
+        return _compute_py(p, env, data)
+
+    controls: list[Slider | Select] = [
+        Slider("delta", "delta", 0.01, 0.99, 0.01, 0.95),
+        Slider("sigma", "sigma", 0.25, 2.0, 0.05, 1.0),
+        Select("bound", "bound", BOUND_CHOICES, "bernstein-er"),
+        Select("estimator", "estimator", (("gpomdp", "G(PO)MDP"), ("reinforce", "REINFORCE")), "gpomdp"),
+        Select("baseline", "baseline", (("on", "on"), ("off", "off")), "on"),
+        Select("score", "score", (("clipped", "clipped action (authors)"), ("raw", "raw action (unbiased)")),
+               "clipped"),
+        Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "1000000"),
+        Slider("seed", "seed", 0, 99, 1, 0),
+        Select("vanilla_n", "vanilla PG: N", (("off", "off"), ("100", "100"), ("1000", "1000"), ("10000", "10000")),
+               "1000"),
+        Select("vanilla_alpha", "alpha", tuple((a, a) for a in ("1e-3", "1e-4", "1e-5", "1e-6")), "1e-4"),
+    ]
+    plots = [Plot("N", "iteration", "batch size N", ylog=True),
+             Plot("J", "trajectories", "expected performance J(theta)"),
+             Plot("alpha", "iteration", "step size alpha", ylog=True)]
+    return LiveLearnerExplorer(TITLE, controls, plots, "", compute_py, data)
+
+
+def _summary(rec: LearningRecord) -> dict[str, Any]:
+    s = rec.summary()
+    return {"iterations": s["iterations"], "trajectories": s["trajectories"], "upsilon_bar": s["upsilon_bar"],
+            "improvement_ratio": s["improvement_ratio"], "J_final": s["J_final"], "theta_final": s["theta"][0],
+            "J_at": {k: v for k, v in s["J_at"].items() if int(k) <= BUDGETS[-1]},
+            "first_batches": rec.batch_size[:3].tolist(), "done": True, "diverged": rec.diverged}
+
+
+def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any]) -> dict[str, Any]:
+    """The Python twin of the page: the same runs with safepg (numpy seeds: adaptive
+    ``seed``, vanilla ``[seed, 1]``), the same plotted structure and values."""
+    budget, seed = int(p["budget"]), int(round(float(p["seed"])))
+    bound = str(p["bound"])
+    common = dict(estimator=p["estimator"], baseline=p["baseline"] == "on", budget=budget,
+                  score_action=p["score"])
+    recs = {"adaptive": adaptive_pg(env, 0.0, float(p["sigma"]), bound=bound.replace("-er", ""),
+                                    delta=float(p["delta"]), empirical_range=bound.endswith("-er"),
+                                    rng=np.random.default_rng(seed), **common)}
+    if p["vanilla_n"] != "off":
+        recs["vanilla"] = vanilla_pg(env, 0.0, float(p["sigma"]), batch_size=int(p["vanilla_n"]),
+                                     alpha=float(p["vanilla_alpha"]), stop_on_divergence=True,
+                                     rng=np.random.default_rng([seed, 1]), **common)
+    plots: dict[str, Any] = {"N": {"series": []}, "J": {"series": []}, "alpha": {"series": []}}
+    values: dict[str, Any] = {"done": True}
+    key = overlay_key(p)
+    run = data["runs"].get(key) if float(p["sigma"]) == 1.0 and p["baseline"] == "on" else None
+    if run is not None:
+        k = next((i for i, s in enumerate(run["start"]) if s is None or s >= budget), len(run["start"]))
+        g = int(np.searchsorted(data["grid"], budget, side="right"))
+        thin = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({run['seeds']} seeds)"}
+        plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **thin})
+        plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **thin})
+        plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **thin})
+        values["thesis"] = {"found": True, "key": key, "name": run["name"], **run["budgets"][str(budget)]}
+    else:
+        values["thesis"] = {"found": False, "key": key}
+    values["vanilla"] = None
+    for name, rec in recs.items():
+        keep = _thin(rec.iterations, data["points"])
+        style = ({"color": data["colors"][bound], "dash": p["estimator"] == "reinforce"} if name == "adaptive"
+                 else {"color": data["vanilla_color"], "dash": False})
+        style["label"] = ("Algorithm 4.1 (safepg)" if name == "adaptive"
+                          else f"vanilla, N = {p['vanilla_n']}, alpha = {p['vanilla_alpha']}")
+        plots["N"]["series"].append({"x": (keep + 1).tolist(), "y": rec.batch_size[keep].tolist(), **style})
+        plots["alpha"]["series"].append({"x": (keep + 1).tolist(), "y": rec.alpha[keep].tolist(), **style})
+        T = np.unique(np.maximum(1, np.round(1 + np.arange(data["points"]) * (budget - 1) / (data["points"] - 1))))
+        T = T[T <= rec.trajectories].astype(np.int64)
+        plots["J"]["series"].append({"x": T.tolist(), "y": performance_on_grid([rec], T)[0].tolist(), **style})
+        values[name] = _summary(rec)
+    a = values["adaptive"]
+    text = (f"Algorithm 4.1: {a['iterations']} iterations, Upsilon-bar {a['upsilon_bar']:.4f}, "
+            f"improvement ratio {100 * a['improvement_ratio']:.2f}%")
+    return {"plots": plots, "values": values, "text": text}
+
+
+__all__ = ["BUDGETS", "LiveLearnerExplorer", "learner_js", "live_batch_size_explorer", "task_data"]
