@@ -7,6 +7,11 @@ from typing import Protocol
 
 import numpy as np
 
+from safepg import portable
+
+#: Values of :attr:`TaskConstants.horizon_term`.
+HORIZON_TERMS = ("effective", "truncated", "horizon")
+
 
 class BoundedTask(Protocol):
     reward_bound: float
@@ -37,6 +42,12 @@ class TaskConstants:
         Horizon.
     sigma : float
         Policy standard deviation.
+    horizon_term : {"effective", "truncated", "horizon"}
+        What the horizon factor h (:attr:`horizon_factor`) of the penalty constant is.
+        ``"effective"`` (default): h = 1 / (1 - gamma), Theorem 4.2.3 as printed, for
+        infinite-horizon discounted returns. ``"truncated"``: h = (1 - gamma^H) / (1 - gamma),
+        the discounted sums cut at the horizon H. ``"horizon"``: h = H, the undiscounted
+        finite-horizon bound. The last two allow gamma = 1 (undiscounted returns).
     """
 
     R: float
@@ -46,20 +57,39 @@ class TaskConstants:
     gamma: float
     H: int
     sigma: float
+    horizon_term: str = "effective"
 
     def __post_init__(self) -> None:
         for name in ("R", "M_phi", "A_volume", "A_bar", "sigma"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v}")
-        if not 0 < self.gamma < 1:
+        if self.horizon_term not in HORIZON_TERMS:
+            raise ValueError(f"horizon_term must be one of {HORIZON_TERMS}, got {self.horizon_term!r}")
+        if self.horizon_term != "effective":  # a finite horizon keeps the sums finite at gamma = 1
+            if not 0 < self.gamma <= 1:
+                raise ValueError(f"gamma must be in (0, 1], got {self.gamma}")
+        elif not 0 < self.gamma < 1:
             raise ValueError(f"gamma must be in (0, 1), got {self.gamma}")
         if int(self.H) != self.H or self.H < 1:
             raise ValueError(f"H must be a positive integer, got {self.H}")
 
+    @property
+    def horizon_factor(self) -> float:
+        """h, the horizon factor of the penalty constant (see ``horizon_term``)."""
+        if self.horizon_term == "effective":
+            return 1.0 / (1.0 - self.gamma)
+        if self.horizon_term == "horizon" or self.gamma == 1:
+            return float(self.H)
+        # portable.ipow: libm's pow is CPU-dependent in the last bit.
+        return (1.0 - portable.ipow(self.gamma, self.H)) / (1.0 - self.gamma)
+
     @classmethod
     def from_task(cls, task: BoundedTask, sigma: float) -> TaskConstants:
-        """Read the constants off an environment for a policy of std ``sigma``."""
+        """Read the constants off an environment for a policy of std ``sigma``.
+
+        A task without a ``horizon_term`` attribute gets ``"effective"`` (Theorem 4.2.3 as printed).
+        """
         return cls(
             R=task.reward_bound,
             M_phi=task.feature_bound,
@@ -68,4 +98,5 @@ class TaskConstants:
             gamma=task.gamma,
             H=task.horizon,
             sigma=float(sigma),
+            horizon_term=getattr(task, "horizon_term", "effective"),
         )

@@ -31,6 +31,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from safepg import portable
+
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
 #: spreads over a few threads, large enough that the per-chunk (H, 4) sums stay small.
@@ -40,8 +42,8 @@ CHUNK = 512
 @njit(cache=True)
 def _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau):
     """One explicit-Euler step; the same operations in the same order as ``step_dynamics``."""
-    sin = math.sin(beta)
-    cos = math.cos(beta)
+    sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
+    cos = portable.cos(beta)
     push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
     x_acc = push - pole_mass * half * beta_acc * cos / total
@@ -49,8 +51,31 @@ def _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau
 
 
 @njit(cache=True)
+def _semi_implicit(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau):
+    """One semi-implicit Euler step (velocities first, positions with the new velocities), the
+    same operations as ``step_dynamics(..., integrator="semi-implicit")``."""
+    sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
+    cos = portable.cos(beta)
+    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
+    x_acc = push - pole_mass * half * beta_acc * cos / total
+    x_dot_new = x_dot + tau * x_acc
+    beta_dot_new = beta_dot + tau * beta_acc
+    return x + tau * x_dot_new, x_dot_new, beta + tau * beta_dot_new, beta_dot_new
+
+
+@njit(cache=True)
+def _step(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau, semi_implicit):
+    """The integrator the task asked for (a branch, so the Euler path keeps its exact operations)."""
+    if semi_implicit:
+        return _semi_implicit(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau)
+    return _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau)
+
+
+@njit(cache=True)
 def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, x_threshold, angle_threshold,
-                score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept):
+                score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept,
+                semi_implicit):
     """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
     lengths, and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
     H = zz.shape[1]
@@ -88,7 +113,8 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
                     den[t, 2] += g2 * g2
                     den[t, 3] += g3 * g3
             disc *= gamma
-            x, x_dot, beta, beta_dot = _euler(x, x_dot, beta, beta_dot, u, half, total, pole_mass, gravity, tau)
+            x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, total, pole_mass, gravity, tau,
+                                             semi_implicit)
             # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
             if not (abs(x) <= x_threshold and abs(beta) <= angle_threshold):
                 T = t + 1
@@ -120,7 +146,7 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
 
 @njit(cache=True)
 def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_clipped, b, suffix,
-                 samples, lengths):
+                 samples, lengths, semi_implicit):
     """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again."""
     half, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
@@ -144,8 +170,8 @@ def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_
             a2 += g2 * b[t, 2]
             a3 += g3 * b[t, 3]
             if t + 1 < T:  # the state after the last step is never used
-                x, x_dot, beta, beta_dot = _euler(x, x_dot, beta, beta_dot, u, half, total, pole_mass,
-                                                  gravity, tau)
+                x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, total, pole_mass,
+                                                 gravity, tau, semi_implicit)
         samples[n, 0] -= a0 + g0 * suffix[T, 0]
         samples[n, 1] -= a1 + g1 * suffix[T, 1]
         samples[n, 2] -= a2 + g2 * suffix[T, 2]
@@ -196,7 +222,7 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                               pole_mass: float, gravity: float, tau: float, s0: np.ndarray, z: np.ndarray,
                               gamma: float, action_bound: float, x_threshold: float, angle_threshold: float,
                               score_clipped: bool, reinforce_estimator: bool,
-                              baseline: bool) -> tuple[np.ndarray, np.ndarray]:
+                              baseline: bool, semi_implicit: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Per-trajectory REINFORCE or G(PO)MDP samples (N, 4) and episode lengths (N,).
 
     Parameters
@@ -218,6 +244,8 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
     score_clipped, reinforce_estimator, baseline : bool
         Score the clipped (applied) action instead of the sampled one; REINFORCE instead
         of G(PO)MDP; subtract the variance-minimising baseline.
+    semi_implicit : bool
+        Integrate with the semi-implicit Euler scheme instead of the explicit one (default).
 
     Returns
     -------
@@ -238,12 +266,13 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
     zz = np.ascontiguousarray(z.reshape(z.shape[0], z.shape[1]))
     return _fused(K, float(sigma), float(pole_length), float(cart_mass), float(pole_mass), float(gravity),
                   float(tau), s0, zz, float(gamma), float(action_bound), float(x_threshold),
-                  float(angle_threshold), bool(score_clipped), bool(reinforce_estimator), bool(baseline))
+                  float(angle_threshold), bool(score_clipped), bool(reinforce_estimator), bool(baseline),
+                  bool(semi_implicit))
 
 
 @njit(cache=True, parallel=True)
 def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, gamma, action_bound, x_threshold,
-           angle_threshold, score_clipped, reinforce_estimator, baseline):
+           angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
     """:func:`cartpole_gradient_samples` on normalised arguments (zz is (N, H))."""
     N, H = zz.shape[0], zz.shape[1]
     n_chunks = (N + CHUNK - 1) // CHUNK
@@ -267,7 +296,7 @@ def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, ga
         j = c * j_step
         _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, gamma,
                     action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
-                    samples, lengths, num[i], den[i], ended[j], kept)
+                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit)
     if not baseline:
         return samples, lengths
 
@@ -280,5 +309,5 @@ def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, ga
 
     for c in prange(n_chunks):
         _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, action_bound,
-                     score_clipped, b, suffix, samples, lengths)
+                     score_clipped, b, suffix, samples, lengths, semi_implicit)
     return samples, lengths

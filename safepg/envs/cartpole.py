@@ -58,7 +58,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from safepg import portable
 from safepg._rng import RNGLike, as_generator
+from safepg.constants import HORIZON_TERMS
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
 from safepg.trajectories import Trajectories
@@ -83,8 +85,9 @@ def step_dynamics(
     pole_mass: float = _POLE_MASS,
     gravity: float = _GRAVITY,
     tau: float = _TAU,
+    integrator: str = "euler",
 ) -> np.ndarray:
-    r"""One explicit-Euler step of the cart-pole, vectorised over leading axes.
+    r"""One explicit-Euler (or semi-implicit Euler) step of the cart-pole, vectorised over leading axes.
 
     Parameters
     ----------
@@ -96,28 +99,77 @@ def step_dynamics(
         *Whole* pole length in m (gymnasium's ``length`` is half of it).
     cart_mass, pole_mass, gravity, tau : float
         Cart and pole masses (kg), gravitational acceleration (m/s^2), time step (s).
+    integrator : {"euler", "semi-implicit"}
+        ``"euler"``: positions advance with the *old* velocities (gymnasium's default
+        ``kinematics_integrator="euler"``). ``"semi-implicit"``: velocities first, then
+        positions with the *new* velocities (gymnasium's ``"semi-implicit euler"``).
 
     Returns
     -------
     ndarray, shape (..., 4)
-        The next states. Positions advance with the old velocities (explicit Euler, as
-        gymnasium's ``CartPoleEnv`` with ``kinematics_integrator="euler"``).
+        The next states.
     """
+    _check_integrator(integrator)
     s = np.asarray(state, dtype=float)
     x, x_dot, beta, beta_dot = s[..., 0], s[..., 1], s[..., 2], s[..., 3]
     half = 0.5 * pole_length  # the equations use the distance hinge -> centre of mass
     total = cart_mass + pole_mass
-    sin, cos = np.sin(beta), np.cos(beta)
+    # The kernel's sine and cosine (safepg.portable): the same bits on every CPU, unlike libm's.
+    sin, cos = portable.sin_array(beta), portable.cos_array(beta)
     # Force on the cart plus the centrifugal pull of the pole, per unit of total mass.
     push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
     x_acc = push - pole_mass * half * beta_acc * cos / total
     out = np.empty(np.broadcast_shapes(s.shape, np.shape(force) + (4,)))
-    out[..., 0] = x + tau * x_dot
     out[..., 1] = x_dot + tau * x_acc
-    out[..., 2] = beta + tau * beta_dot
     out[..., 3] = beta_dot + tau * beta_acc
+    if integrator == "euler":
+        out[..., 0] = x + tau * x_dot
+        out[..., 2] = beta + tau * beta_dot
+    else:  # semi-implicit: the positions move with the velocities just computed
+        out[..., 0] = x + tau * out[..., 1]
+        out[..., 2] = beta + tau * out[..., 3]
     return out
+
+
+#: ``feature_scale`` of the normalised-feature setting: each state component divided by its
+#: bound, 2.4 m and 41.8 deg for the alive region, 10 for the two velocities (the measured
+#: bound of ``CartPole.feature_bound``), so that |phi_i| <= 1 and M_phi = 1.
+NORMALISED_SCALE = (2.4, 10.0, round(math.radians(41.8), 4), 10.0)
+
+
+def _fmt(v: Any) -> str:
+    """A setting's value as it appears in a task name (shortest exact float repr)."""
+    return repr(float(v)) if isinstance(v, float) and not float(v).is_integer() else (
+        f"{int(v)}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v))
+
+
+def _parse_setting(key: str, text: str) -> Any:
+    """Read one ``field=value`` of a task name (see :meth:`CartPole.from_name`)."""
+    if key == "feature_scale":
+        if text == "None":
+            return None
+        try:
+            return tuple(float(x) for x in text.split("/"))
+        except ValueError:
+            raise ValueError(f"feature_scale must be four numbers separated by '/', got {text!r}") from None
+    if key in ("integrator", "horizon_term"):
+        return text
+    if text == "None":
+        return None
+    try:
+        return int(text) if key == "horizon" else float(text)
+    except ValueError:
+        raise ValueError(f"{key} must be a number, got {text!r}") from None
+
+
+#: Integration schemes of :func:`step_dynamics` (gymnasium's two ``kinematics_integrator`` values).
+INTEGRATORS = ("euler", "semi-implicit")
+
+
+def _check_integrator(integrator: str) -> None:
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
 
 
 @dataclass(frozen=True)
@@ -162,6 +214,27 @@ class CartPole:
     init_bound : float
         The initial state is uniform in [-init_bound, init_bound]^4. The thesis says "a
         small neighborhood of 0"; ours: gymnasium's 0.05.
+    integrator : {"euler", "semi-implicit"}
+        Integration scheme (unstated in the thesis). Ours: gymnasium's default ``"euler"``.
+    feature_scale : tuple of 4 floats or None
+        None (default): the features are the raw state, phi(s) = s. Otherwise the policy
+        sees the *normalised* state phi(s) = s / feature_scale, a = theta^T phi(s) + noise,
+        and theta and the gradient are in those units (set ``feature_bound`` to the bound
+        on the normalised features, e.g. 1). :data:`NORMALISED_SCALE` divides each
+        component by its alive-region bound (2.4 m, 41.8 deg) or by the measured
+        velocity bound (10).
+    reward_bound : float
+        R of the bounds, max |r_t|. The reward is 1 while alive, so 1 (default) is the
+        tight value; a larger R (e.g. H, a bound on the return) only makes the step smaller.
+    action_space_volume : float or None
+        |A| of the penalty constant; None (default) is the length of the force interval,
+        2 A-bar = 20.
+    horizon_term : {"effective", "truncated", "horizon"}
+        The horizon factor h that replaces 1 / (1 - gamma) in the penalty constant
+        (Theorem 4.2.3 is stated for infinite-horizon discounted returns):
+        ``"effective"`` (default) h = 1 / (1 - gamma), as printed; ``"truncated"``
+        h = (1 - gamma^H) / (1 - gamma), the discounted sums cut at H; ``"horizon"``
+        h = H = 200. Only the bound constants change, not the simulation.
     """
 
     pole_length: float = _POLE_LENGTH
@@ -176,12 +249,16 @@ class CartPole:
     gravity: float = _GRAVITY
     tau: float = _TAU
     init_bound: float = 0.05
+    integrator: str = "euler"
+    feature_scale: tuple[float, float, float, float] | None = None
+    #: R = max |r|: the reward is 1 while alive and 0 afterwards.
+    reward_bound: float = 1.0
+    action_space_volume: float | None = None
+    horizon_term: str = "effective"
 
-    #: State and action dimensions (the features are the state: d_phi = 4).
+    #: State and action dimensions (the features are the state, or its normalisation: d_phi = 4).
     state_dim: ClassVar[int] = 4
     action_dim: ClassVar[int] = 1
-    #: R = max |r|: the reward is 1 while alive and 0 afterwards.
-    reward_bound: ClassVar[float] = 1.0
 
     def __post_init__(self) -> None:
         if not 0 < self.gamma <= 1:
@@ -189,10 +266,21 @@ class CartPole:
         if int(self.horizon) != self.horizon or self.horizon < 1:
             raise ValueError(f"horizon must be a positive integer, got {self.horizon}")
         for name in ("pole_length", "angle_threshold_deg", "x_threshold", "action_bound", "feature_bound",
-                     "cart_mass", "pole_mass", "gravity", "tau", "init_bound"):
+                     "cart_mass", "pole_mass", "gravity", "tau", "init_bound", "reward_bound"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v}")
+        _check_integrator(self.integrator)
+        if self.horizon_term not in HORIZON_TERMS:
+            raise ValueError(f"horizon_term must be one of {HORIZON_TERMS}, got {self.horizon_term!r}")
+        v = self.action_space_volume
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ValueError(f"action_space_volume must be finite and > 0 or None, got {v}")
+        if self.feature_scale is not None:
+            sc = self.feature_scale
+            if (not isinstance(sc, tuple) or len(sc) != self.state_dim
+                    or not all(isinstance(x, (int, float)) and math.isfinite(x) and x > 0 for x in sc)):
+                raise ValueError(f"feature_scale must be None or a tuple of 4 finite numbers > 0, got {sc!r}")
         if self.init_bound >= min(self.x_threshold, self.angle_threshold):
             raise ValueError(f"init_bound must leave the initial state alive, got {self.init_bound}")
 
@@ -215,14 +303,60 @@ class CartPole:
 
     @property
     def action_volume(self) -> float:
-        """|A|: length of the force interval, 2 A-bar = 20."""
+        """|A|: ``action_space_volume`` if set, else the length of the force interval, 2 A-bar = 20."""
+        if self.action_space_volume is not None:
+            return float(self.action_space_volume)
         return float(2 * self.action_bound)
+
+    # ------------------------------------------------------------ named settings
+    @classmethod
+    def from_name(cls, name: str) -> CartPole:
+        """The task named ``"cartpole"`` or ``"cartpole-doubled"``, optionally followed by
+        field overrides in brackets: ``"cartpole-doubled[gamma=0.9,feature_bound=1]"``.
+
+        Values are read as int, float or string; ``feature_scale`` takes four numbers
+        separated by ``/`` (``feature_scale=2.4/10/0.7295/10``). :meth:`setting_name` is the inverse.
+        The experiments use these names to run the settings of the cart-pole sweep.
+        """
+        if not isinstance(name, str):
+            raise ValueError(f"name must be a string, got {name!r}")
+        base, bracket, rest = name.partition("[")
+        makers = {"cartpole": cls.thesis, "cartpole-doubled": cls.thesis_doubled}
+        if base not in makers or (bracket and not rest.endswith("]")):
+            raise ValueError(f"name must be 'cartpole' or 'cartpole-doubled', optionally with [field=value,...], "
+                             f"got {name!r}")
+        fields = {f for f in cls.__dataclass_fields__}
+        overrides: dict[str, Any] = {}
+        for item in filter(None, rest[:-1].split(",")) if bracket else ():
+            key, eq, text = item.partition("=")
+            if not eq or key not in fields or key == "pole_length":
+                raise ValueError(f"name has an unknown or malformed setting {item!r} in {name!r}")
+            overrides[key] = _parse_setting(key, text)
+        return makers[base](**overrides)
+
+    def setting_name(self) -> str:
+        """The :meth:`from_name` name of this task: the base task and the fields that differ from it."""
+        doubled = self.pole_length == 2 * _POLE_LENGTH
+        base = type(self).thesis_doubled() if doubled else type(self).thesis()
+        if not doubled and self.pole_length != _POLE_LENGTH:
+            raise ValueError(f"pole_length must be 1 or 2 m to have a name, got {self.pole_length}")
+        parts = []
+        for key in self.__dataclass_fields__:
+            v = getattr(self, key)
+            if v != getattr(base, key):
+                parts.append(f"{key}={'/'.join(f'{x:g}' for x in v) if key == 'feature_scale' else _fmt(v)}")
+        return ("cartpole-doubled" if doubled else "cartpole") + (f"[{','.join(parts)}]" if parts else "")
 
     # ------------------------------------------------------------------ dynamics
     def step(self, state: np.ndarray, force: np.ndarray | float) -> np.ndarray:
         """:func:`step_dynamics` with this task's physical constants (force not clipped)."""
         return step_dynamics(state, force, self.pole_length, cart_mass=self.cart_mass, pole_mass=self.pole_mass,
-                             gravity=self.gravity, tau=self.tau)
+                             gravity=self.gravity, tau=self.tau, integrator=self.integrator)
+
+    def features(self, state: np.ndarray) -> np.ndarray:
+        """phi(s): the state itself, or ``state / feature_scale`` with normalised features."""
+        s = np.asarray(state, dtype=float)
+        return s if self.feature_scale is None else s / np.asarray(self.feature_scale)
 
     def alive(self, state: np.ndarray) -> np.ndarray:
         """Whether states (..., 4) are inside the thresholds (|x| <= 2.4, |beta| <= 41.8 deg)."""
@@ -252,7 +386,7 @@ class CartPole:
         Returns
         -------
         Trajectories
-            features = states, actions_raw = sampled forces, actions = clipped forces,
+            features = states (or their normalisation, see ``feature_scale``), actions_raw = sampled forces, actions = clipped forces,
             rewards = 1 while alive, mask = alive; zeros at dead steps.
         """
         n = self._check_policy_and_n(policy, n)
@@ -260,6 +394,7 @@ class CartPole:
         H, b = self.horizon, self.action_bound
         K = policy.gain[0]
         std = float(policy.cov_chol[0, 0])
+        scale = None if self.feature_scale is None else np.asarray(self.feature_scale)
 
         s = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
         noise = rng.standard_normal((n, H, 1))
@@ -273,8 +408,11 @@ class CartPole:
             if not alive.any():  # every episode has ended: the rest stays zero
                 break
             alive_t[t] = alive
-            feats[t] = s
-            raw[t] = s @ K + std * noise[:, t, 0]
+            phi = s if scale is None else s / scale
+            feats[t] = phi
+            # K phi summed left to right as in the kernel (``@`` would go through BLAS).
+            raw[t] = (((K[0] * phi[:, 0] + K[1] * phi[:, 1]) + K[2] * phi[:, 2]) + K[3] * phi[:, 3]
+                      + std * noise[:, t, 0])
             # Dead carts are frozen, not integrated: a fallen pole under linear feedback can
             # grow without bound (overflow warnings) and its state is never used again.
             s = np.where(alive[:, None], self.step(s, np.clip(raw[t], -b, b)), s)
@@ -350,11 +488,22 @@ class CartPole:
         rng = as_generator(rng)
         s0 = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
         z = rng.standard_normal((n, self.horizon, self.action_dim))
+        gain = policy.gain[0]
+        if self.feature_scale is not None:
+            # theta^T (s / scale) = (theta / scale)^T s: the kernel runs on the raw state with
+            # the equivalent gain, and the score of theta is the raw-state score / scale
+            # (the variance-minimising baselines are unchanged by a per-component scale).
+            scale = np.asarray(self.feature_scale)
+            gain = gain / scale
         # The wrapper normalises the argument types (one compiled specialisation).
-        return cartpole_gradient_samples(
-            policy.gain[0], policy.cov_chol[0, 0], self.pole_length, self.cart_mass, self.pole_mass, self.gravity,
+        samples, returns = cartpole_gradient_samples(
+            gain, policy.cov_chol[0, 0], self.pole_length, self.cart_mass, self.pole_mass, self.gravity,
             self.tau, s0, z, self.gamma, self.action_bound, self.x_threshold, self.angle_threshold,
-            score_action == "clipped", estimator == "reinforce", baseline)
+            score_action == "clipped", estimator == "reinforce", baseline,
+            semi_implicit=self.integrator == "semi-implicit")
+        if self.feature_scale is not None:
+            samples /= scale
+        return samples, returns
 
     def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
                       rng: RNGLike = None) -> Trajectories:
@@ -482,7 +631,8 @@ if _gym is not None:
             self._truncated = not self._terminated and self._t >= self.task.horizon
             return self.state.copy(), 1.0, self._terminated, self._truncated, {}
 
-    def gymnasium_step(states: np.ndarray, forces: np.ndarray, pole_length: float = _POLE_LENGTH) -> np.ndarray:
+    def gymnasium_step(states: np.ndarray, forces: np.ndarray, pole_length: float = _POLE_LENGTH,
+                       integrator: str = "euler") -> np.ndarray:
         """One step of gymnasium's own ``CartPoleEnv`` from each state with each force.
 
         The independent implementation :func:`step_dynamics` is checked against (tests
@@ -497,8 +647,12 @@ if _gym is not None:
         forces : ndarray, shape (n,)
         pole_length : float
             Whole pole length in m.
+        integrator : {"euler", "semi-implicit"}
+            gymnasium's ``kinematics_integrator`` ``"euler"`` or ``"semi-implicit euler"``.
         """
         from gymnasium.envs.classic_control.cartpole import CartPoleEnv
+
+        _check_integrator(integrator)
 
         S = np.asarray(states, dtype=float).reshape(-1, 4)
         F = np.asarray(forces, dtype=float).reshape(-1)
@@ -508,6 +662,7 @@ if _gym is not None:
         env.reset(seed=0)
         env.length = 0.5 * pole_length
         env.polemass_length = env.masspole * env.length  # cached in __init__: keep it consistent
+        env.kinematics_integrator = "euler" if integrator == "euler" else "semi-implicit euler"
         out = np.empty_like(S)
         with warnings.catch_warnings():  # stepping "after termination" is what we want here
             warnings.simplefilter("ignore")
