@@ -128,10 +128,14 @@ def make_env(name: str) -> Any:
 
     ``lqg1d`` (Section 5.1), ``lqg2d`` (Section 5.2 as printed, gamma = 0.95),
     ``lqg2d-gamma0.9`` (the discount the Section 5.2 experiments run with),
-    ``cartpole`` and ``cartpole-doubled`` (Section 5.3: 1 m pole, then 2 m).
+    ``cartpole`` and ``cartpole-doubled`` (Section 5.3: 1 m pole, then 2 m), optionally
+    with settings in brackets, ``cartpole-doubled[gamma=0.995]`` (:meth:`CartPole.from_name`).
     """
     from safepg.envs.cartpole import CartPole
     from safepg.envs.lqg import LQG
+
+    if name.startswith(("cartpole[", "cartpole-doubled[")):  # a setting of the cart-pole sweep
+        return CartPole.from_name(name)
 
     envs = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d,
             "lqg2d-gamma0.9": lambda: LQG.thesis_2d(gamma=LQG2D_GAMMA),
@@ -338,12 +342,125 @@ def _warm_start_config(name: str) -> RunConfig:
 def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
     """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
     cfg = _warm_start_config(name)
+# The cart-pole sweep (issue 13): which unstated settings let the adaptive step move on the
+# doubled pole? :mod:`safepg.cartpole_sweep` computes the penalty constant over the whole grid
+# of settings analytically and reads these runs back for the chapter.
+
+#: Trajectories per doubled-pole run of the sweep (both methods: 100 iterations of the
+#: vanilla N = 4000) and seeds per setting. Small on purpose, so that the chapter's sweep costs
+#: a few minutes; ``table-5.4`` is the full-budget protocol at the default setting.
+SWEEP_BUDGET = 400_000
+SWEEP_SEEDS = 2
+#: Cap on a sweep baseline search: 250 iterations of N = 4000 (the thesis needed 72).
+SWEEP_BASELINE_CAP = 4000 * 250
+
+
+@dataclass(frozen=True)
+class SweepSetting:
+    """One setting of the cart-pole sweep.
+
+    ``task`` overrides the :class:`~safepg.envs.cartpole.CartPole` fields that change what
+    is simulated or how vanilla PG learns (so the setting has its own baseline policy);
+    ``constants`` overrides only the bound constants (R, M_phi, |A|, horizon term), which
+    change nothing but the adaptive method's penalty constant c. ``doubled``: run the
+    doubled-pole comparison (False: the baseline search only). ``plausible``: False for
+    the counterfactual settings that only locate how small c must be. ``warm_start``: the
+    baseline experiment to start from instead of the setting's own (for a discount whose
+    own baseline search never reaches 195).
+    """
+
+    key: str
+    label: str
+    task: dict[str, Any] = field(default_factory=dict)
+    constants: dict[str, Any] = field(default_factory=dict)
+    doubled: bool = True
+    plausible: bool = True
+    warm_start: str | None = None
+
+    def env(self, doubled: bool, constants: bool = True) -> str:
+        """The :func:`make_env` name of this setting's task (with or without the constants)."""
+        from safepg.envs.cartpole import CartPole
+
+        base = CartPole.thesis_doubled if doubled else CartPole.thesis
+        return base(**self.task, **(self.constants if constants else {})).setting_name()
+
+    @property
+    def baseline_experiment(self) -> str:
+        """The experiment whose runs are this setting's baseline policies."""
+        if self.warm_start is not None:
+            return self.warm_start
+        return "cartpole-baseline" if not self.task else f"cartpole-baseline-{self.key}"
+
+
+def _sweep_settings() -> tuple[SweepSetting, ...]:
+    from safepg.envs.cartpole import NORMALISED_SCALE
+
+    return (
+        SweepSetting("thesis", "ours (default)"),
+        SweepSetting("gamma=0.95", "gamma 0.95", {"gamma": 0.95}, doubled=False),
+        SweepSetting("gamma=0.995", "gamma 0.995", {"gamma": 0.995}),
+        SweepSetting("gamma=0.999", "gamma 0.999", {"gamma": 0.999}),
+        SweepSetting("semi-implicit", "semi-implicit Euler", {"integrator": "semi-implicit"}),
+        SweepSetting("angle=12", "12 deg termination", {"angle_threshold_deg": 12.0}),
+        SweepSetting("normalised", "normalised features, M_phi 1",
+                     {"feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0}),
+        # The discounts where the safe step can move (c ~ 10^3 - 10^4), adapting the normalised
+        # baseline (their own baseline searches stall far below 195).
+        SweepSetting("gamma=0.95+normalised", "gamma 0.95, normalised",
+                     {"gamma": 0.95, "feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0},
+                     warm_start="cartpole-baseline-normalised"),
+        SweepSetting("gamma=0.9+normalised", "gamma 0.9, normalised",
+                     {"gamma": 0.9, "feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0},
+                     warm_start="cartpole-baseline-normalised"),
+        SweepSetting("M_phi=1", "M_phi 1", constants={"feature_bound": 1.0}, plausible=False),
+        SweepSetting("M_phi=0.1", "M_phi 0.1", constants={"feature_bound": 0.1}, plausible=False),
+        SweepSetting("M_phi=0.03", "M_phi 0.03", constants={"feature_bound": 0.03}, plausible=False),
+        SweepSetting("M_phi=0.01", "M_phi 0.01", constants={"feature_bound": 0.01}, plausible=False),
+    )
+
+
+#: The settings of the cart-pole sweep, by key.
+CARTPOLE_SWEEP: dict[str, SweepSetting] = {st.key: st for st in _sweep_settings()}
+
+
+def _sweep_baselines() -> list[Experiment]:
+    base = _cartpole_baseline()
+    out = []
+    for st in CARTPOLE_SWEEP.values():
+        if st.task and st.warm_start is None:
+            cfg = replace(base.configs[0], env=st.env(doubled=False, constants=False), budget=SWEEP_BASELINE_CAP)
+            out.append(replace(base, name=st.baseline_experiment, configs=(cfg,), seeds=SWEEP_SEEDS,
+                               description=f"Cart-pole sweep: the baseline search with {st.label} "
+                                           f"(capped at {SWEEP_BASELINE_CAP // 4000} iterations)."))
+    return out
+
+
+def _cartpole_sweep() -> Experiment:
+    t54 = _table_5_4()
+    adaptive, vanilla = t54.config("adaptive"), t54.config("N=4000")
+    configs = []
+    for st in CARTPOLE_SWEEP.values():
+        if not st.doubled:
+            continue
+        common = dict(warm_start=st.baseline_experiment, budget=SWEEP_BUDGET)
+        configs.append(replace(adaptive, name=f"{st.key}:adaptive", env=st.env(doubled=True), **common))
+        if not st.constants or st.task:  # a constants-only setting shares the default's vanilla run
+            configs.append(replace(vanilla, name=f"{st.key}:N=4000", env=st.env(doubled=True, constants=False),
+                                   **common))
+    return Experiment("cartpole-sweep", "Cart-pole sweep over the unstated settings (issue 13): adaptive "
+                      "(Bernstein with empirical range, delta = 0.95) and vanilla (alpha = 0.01, N = 4000) on "
+                      f"the doubled pole from each setting's baseline, {SWEEP_BUDGET:.0e} trajectories, "
+                      f"{SWEEP_SEEDS} seeds.", tuple(configs), SWEEP_SEEDS, {}, "J_hat")
+
     path = run_path(get_experiment(name), cfg, k, root)
     rec = _stored(path, cfg)
     if rec is None:
         rec = _compute(cfg, k, None, single_thread=False)
         _save_atomic(rec, path)
     return rec.theta_final
+# The cart-pole sweep's experiments (kept out of the tuple above so the two blocks are edited apart).
+EXPERIMENTS.update({e.name: e for e in (*_sweep_baselines(), _cartpole_sweep())})
+
 
 
 def get_experiment(name: str) -> Experiment:

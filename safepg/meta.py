@@ -27,7 +27,14 @@ def penalty_constant(k: TaskConstants) -> float:
               \Big(\frac{|\mathcal A|}{\sqrt{2\pi}\,\sigma} + \frac{\gamma}{2(1-\gamma)}\Big)
     """
     g, s = k.gamma, k.sigma
-    return k.R * k.M_phi**2 / ((1 - g) ** 2 * s**2) * (
+    if getattr(k, "horizon_term", "effective") != "effective":
+        # The same constant with 1 / (1 - gamma) replaced by the horizon factor h
+        # (TaskConstants.horizon_term): c = R M^2 h^2 / sigma^2 (|A| / (sqrt(2 pi) sigma) + gamma h / 2).
+        h = k.horizon_factor
+        return k.R * (k.M_phi * k.M_phi) * (h * h) / (s * s) * (k.A_volume / (math.sqrt(2 * math.pi) * s) + g * h / 2)
+    # Squares as products (bit-exact, like the correctly rounded x**2); Python's ** calls
+    # libm's pow, whose last bit depends on the CPU (safepg.portable).
+    return k.R * (k.M_phi * k.M_phi) / ((1 - g) * (1 - g) * (s * s)) * (
         k.A_volume / (math.sqrt(2 * math.pi) * s) + g / (2 * (1 - g))
     )
 
