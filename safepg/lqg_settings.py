@@ -376,8 +376,127 @@ def search_printed_settings(
     return sorted(out, key=lambda r: (r["quantity"], r["rel_error"]))
 
 
+
+# ----------------------------------------------------------- the lab library's closed form
+#: Initial states listed in the lab library's 2-D LQG (teopir/ifqi, ``ifqi/envs/lqgnd.py``):
+#: (x, 0) for x = 1, 2, 5, 7, 10. Read only to evaluate one more reading of J.
+LAB_INITIAL_STATES = np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 0.0], [7.0, 0.0], [10.0, 0.0]])
+
+
+def lab_value_matrix(theta: np.ndarray, weight: float, gamma: float) -> np.ndarray:
+    r"""P as the authors' lab library computes it for A = B = I and Q = R = ``weight`` I.
+
+    .. math:: P = (Q + K^\top R K)\,\big(I - \gamma(I + 2K + K\circ K)\big)^{-1}
+
+    with :math:`K\circ K` the *elementwise* square (the library writes ``K ** 2``). For a
+    diagonal K this is the exact discounted Lyapunov solution; otherwise it is not.
+    The library's reward has no 1/2: cost :math:`s^\top Qs + a^\top Ra`, so
+    ``weight = 0.5`` is the thesis's reward and 0.9 the library's default.
+    """
+    K = np.atleast_2d(np.asarray(theta, dtype=float))
+    m = K.shape[0]
+    if K.shape != (m, m):
+        raise ValueError(f"theta must be a square gain matrix, got shape {K.shape}")
+    if not 0 < gamma < 1:
+        raise ValueError(f"gamma must be in (0, 1), got {gamma}")
+    if not weight > 0:
+        raise ValueError(f"weight must be > 0, got {weight}")
+    eye = np.eye(m)
+    return (weight * eye + weight * K.T @ K) @ np.linalg.inv(eye - gamma * (eye + 2 * K + K * K))
+
+
+def lab_performance_moments(theta: np.ndarray, noise_cov: float | np.ndarray, weight: float, gamma: float,
+                            state_bound: float, n_x0: int = 100) -> tuple[float, float]:
+    r"""Mean and standard deviation of the lab library's Monte Carlo J.
+
+    The library's ``computeJ`` returns
+
+    .. math:: J = -\frac1{n}\sum_{i=1}^{n} x_i^\top P x_i
+              - \frac{\operatorname{tr}\big(\Sigma (R + \gamma P)\big)}{1-\gamma},
+              \qquad x_i \sim \mathcal U([-b, b]^m)
+
+    with n = 100 fresh initial states per call, so it is a random number. Its exact mean
+    and standard deviation follow from :math:`\mathbb E[x_i^2] = b^2/3` and
+    :math:`\operatorname{Var}[x_i^2] = 4b^4/45` (independent coordinates).
+
+    Parameters
+    ----------
+    theta : ndarray (m, m)
+        Gain K.
+    noise_cov : float or ndarray
+        :math:`\Sigma`, what the library receives as the action noise's covariance (a
+        scalar means that multiple of I: the library passes sigma itself there).
+    weight, gamma : float
+        Q = R = weight I, and the discount.
+    state_bound : float
+        b, the half-width of the initial-state box (2 in the thesis, 10 in the library).
+    n_x0 : int
+        Initial states per call (100 in the library).
+    """
+    if int(n_x0) != n_x0 or n_x0 < 1:
+        raise ValueError(f"n_x0 must be a positive integer, got {n_x0}")
+    if not state_bound > 0:
+        raise ValueError(f"state_bound must be > 0, got {state_bound}")
+    P = lab_value_matrix(theta, weight, gamma)
+    m = P.shape[0]
+    S = np.eye(m) * noise_cov if np.ndim(noise_cov) == 0 else np.asarray(noise_cov, dtype=float)
+    W = float(np.trace(S @ (weight * np.eye(m) + gamma * P))) / (1 - gamma)
+    b2 = state_bound**2
+    mean = -float(np.trace(P)) * b2 / 3 - W
+    off = P + P.T
+    var = np.sum(np.diag(P) ** 2) * 4 * b2**2 / 45 + np.sum(np.triu(off, 1) ** 2) * (b2 / 3) ** 2
+    return mean, float(np.sqrt(var / n_x0))
+
+
+def lab_performance_at_states(theta: np.ndarray, noise_cov: float | np.ndarray, weight: float, gamma: float,
+                              states: np.ndarray = LAB_INITIAL_STATES) -> float:
+    """The lab library's J averaged over a fixed list of initial states (its ``initial_states``)."""
+    P = lab_value_matrix(theta, weight, gamma)
+    m = P.shape[0]
+    S = np.eye(m) * noise_cov if np.ndim(noise_cov) == 0 else np.asarray(noise_cov, dtype=float)
+    W = float(np.trace(S @ (weight * np.eye(m) + gamma * P))) / (1 - gamma)
+    x = np.asarray(states, dtype=float)
+    return float(-np.mean(np.einsum("ni,ij,nj->n", x, P, x)) - W)
+
+
+def lab_readings(
+    gammas: Sequence[float] = (0.9, 0.95, 0.99),
+    weights: Sequence[float] = (0.5, 0.9, 1.0),
+    state_bounds: Sequence[float] = (2.0, 10.0),
+    sigma: float = 1.0,
+    target: float = PRINTED_J_STAR,
+) -> list[dict[str, Any]]:
+    """J(theta) of the 2-D task under the lab library's closed form, for every reading.
+
+    Enumerates the discount (the thesis's 0.95, the 0.9 that reproduces theta*, the
+    library's 0.99), Q = R = weight I (0.5: the thesis's reward; 0.9: the library's; 1:
+    the thesis's Q = R = I without the 1/2), the initial-state box (the thesis's 2, the
+    library's 10), sigma or sigma^2 as the noise covariance, and the point: the printed
+    theta* = diag(-0.588), the setting's own optimum, and 0. Each row gives the mean and
+    standard deviation of the library's Monte Carlo J (100 initial states), its distance to
+    ``target`` in standard deviations (``z``), and J over the library's fixed initial states.
+    """
+    rows = []
+    for gamma in gammas:
+        k_star = float(LQG(dim=2, gamma=gamma, clip=False).optimal_gain()[0, 0])
+        for point, k in (("printed theta*", PRINTED_THETA_STAR), ("own optimum", k_star), ("zero", 0.0)):
+            K = k * np.eye(2)
+            for weight in weights:
+                for cov_name, cov in (("sigma^2", sigma**2), ("sigma", sigma)):
+                    if cov_name == "sigma" and sigma == 1.0:
+                        continue  # identical to sigma^2 at the printed sigma = 1
+                    fixed = lab_performance_at_states(K, cov, weight, gamma)
+                    for b in state_bounds:
+                        mean, sd = lab_performance_moments(K, cov, weight, gamma, b)
+                        rows.append({"gamma": gamma, "point": point, "theta_11": k, "weight": weight, "cov": cov_name,
+                                     "state_bound": b, "J_mean": mean, "J_sd": sd, "z": (target - mean) / sd,
+                                     "J_fixed_states": fixed})
+    return sorted(rows, key=lambda r: abs(r["z"]))
+
+
 __all__ = [
     "FIXED_POINTS",
+    "LAB_INITIAL_STATES",
     "PRINTED_FINAL_COORDINATE",
     "PRINTED_FINAL_SCALAR",
     "PRINTED_J_STAR",
@@ -390,6 +509,10 @@ __all__ = [
     "finite_horizon_optimal_gain",
     "finite_horizon_performance",
     "horizon_matching_value",
+    "lab_performance_at_states",
+    "lab_performance_moments",
+    "lab_readings",
+    "lab_value_matrix",
     "measured_return",
     "search_printed_settings",
     "second_moments",

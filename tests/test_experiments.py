@@ -26,7 +26,10 @@ def test_definitions_match_the_thesis():
     assert len(t51.configs) == 24 and {c.budget for c in t51.configs} == {1_000_000}
     assert {(c.sigma, c.batch_size, c.alpha) for c in t51.configs} == {
         (s, n, a) for s in (0.5, 1.0) for n in (10_000, 1_000, 100) for a in (1e-3, 1e-4, 1e-5, 1e-6)}
-    assert all(c.theta0 == (-0.55,) and c.estimator == "gpomdp" for c in t51.configs)
+    # Run from the reconstructed theta_0 = -0.575 (the thesis prints -0.55: table-5.1-printed-theta0).
+    assert all(c.theta0 == (-0.575,) and c.estimator == "gpomdp" and c.baseline for c in t51.configs)
+    printed = ex.get_experiment("table-5.1-printed-theta0")
+    assert [replace(c, theta0=(-0.575,)) for c in printed.configs] == list(t51.configs)
     assert len(t52.configs) == 12 and t52.seeds == 5
     assert all(c.budget == 30_000_000 and c.theta0 == (0.0,) and c.sigma == 1.0 for c in t52.configs)
     assert sum(c.estimator == "reinforce" for c in t52.configs) == 3
