@@ -342,23 +342,6 @@ def _table_5_4() -> Experiment:
                       "Figure 5.9).", configs, 5, thesis, "J_hat")
 
 
-EXPERIMENTS: dict[str, Experiment] = {
-    e.name: e for e in (_table_5_1(), _table_5_1_printed_theta0(), _table_5_1_no_baseline(), _table_5_2(),
-                        _table_5_2_lemma_range(), _table_5_2_raw_score(), _figures_5_5_5_6(), _table_5_3(),
-                        _cartpole_baseline(), _table_5_4())
-}
-
-
-def _warm_start_config(name: str) -> RunConfig:
-    exp = get_experiment(name)
-    if len(exp.configs) != 1:
-        raise ValueError(f"warm_start must name an experiment with one config, {name!r} has {len(exp.configs)}")
-    return exp.configs[0]
-
-
-def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
-    """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
-    cfg = _warm_start_config(name)
 # The cart-pole sweep (issue 13): which unstated settings let the adaptive step move on the
 # doubled pole? :mod:`safepg.cartpole_sweep` computes the penalty constant over the whole grid
 # of settings analytically and reads these runs back for the chapter.
@@ -419,7 +402,9 @@ def _sweep_settings() -> tuple[SweepSetting, ...]:
         SweepSetting("gamma=0.999", "gamma 0.999", {"gamma": 0.999}),
         SweepSetting("semi-implicit", "semi-implicit Euler", {"integrator": "semi-implicit"}),
         SweepSetting("angle=12", "12 deg termination", {"angle_threshold_deg": 12.0}),
-        SweepSetting("normalised", "normalised features, M_phi 1",
+        SweepSetting("tau=0.01", "time step 0.01 s", {"tau": 0.01}),
+        SweepSetting("init=0.1", "initial state in [-0.1, 0.1]^4", {"init_bound": 0.1}, doubled=False),
+        SweepSetting("normalised", "normalised features",
                      {"feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0}),
         # The discounts where the safe step can move (c ~ 10^3 - 10^4), adapting the normalised
         # baseline (their own baseline searches stall far below 195).
@@ -469,15 +454,32 @@ def _cartpole_sweep() -> Experiment:
                       f"the doubled pole from each setting's baseline, {SWEEP_BUDGET:.0e} trajectories, "
                       f"{SWEEP_SEEDS} seeds.", tuple(configs), SWEEP_SEEDS, {}, "J_hat")
 
+EXPERIMENTS: dict[str, Experiment] = {
+    e.name: e for e in (_table_5_1(), _table_5_1_printed_theta0(), _table_5_1_no_baseline(), _table_5_2(),
+                        _table_5_2_lemma_range(), _table_5_2_raw_score(), _figures_5_5_5_6(), _table_5_3(),
+                        _cartpole_baseline(), _table_5_4())
+}
+
+# The cart-pole sweep's experiments (kept out of the tuple above so the two blocks are edited apart).
+EXPERIMENTS.update({e.name: e for e in (*_sweep_baselines(), _cartpole_sweep())})
+
+
+def _warm_start_config(name: str) -> RunConfig:
+    exp = get_experiment(name)
+    if len(exp.configs) != 1:
+        raise ValueError(f"warm_start must name an experiment with one config, {name!r} has {len(exp.configs)}")
+    return exp.configs[0]
+
+
+def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
+    """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
+    cfg = _warm_start_config(name)
     path = run_path(get_experiment(name), cfg, k, root)
     rec = _stored(path, cfg)
     if rec is None:
         rec = _compute(cfg, k, None, single_thread=False)
-        _save_atomic(rec, path)
+        _store(rec, cfg, path)
     return rec.theta_final
-# The cart-pole sweep's experiments (kept out of the tuple above so the two blocks are edited apart).
-EXPERIMENTS.update({e.name: e for e in (*_sweep_baselines(), _cartpole_sweep())})
-
 
 
 def get_experiment(name: str) -> Experiment:
@@ -596,10 +598,15 @@ def _compute(cfg: RunConfig, k: int, theta0: np.ndarray | None, single_thread: b
         import numba
 
         numba.set_num_threads(1)
-    rec = cfg.run(k, theta0=theta0)
+    return cfg.run(k, theta0=theta0)
+
+
+def _store(rec: LearningRecord, cfg: RunConfig, path: Path) -> None:
+    """Stamp ``rec`` with the key :func:`_stored` checks and save it (in the calling process,
+    so the stamp is this process's key whatever the worker's copy of the definitions)."""
     rec.config["run_key"] = cfg.key()
     rec.config["config_name"] = cfg.name
-    return rec
+    _save_atomic(rec, path)
 
 
 def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
@@ -653,7 +660,7 @@ def run_experiment(
         with tqdm(total=len(todo), desc=exp.name, unit="run", disable=not progress) as bar:
             for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
                 c, k = todo[i]
-                _save_atomic(rec, run_path(exp, c, k, root))
+                _store(rec, c, run_path(exp, c, k, root))
                 bar.update()
     return load_experiment(exp, root)
 
