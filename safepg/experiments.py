@@ -551,7 +551,7 @@ def _save_atomic(rec: LearningRecord, path: Path) -> None:
 
 def _pid_alive(pid: int) -> bool:
     """Whether process ``pid`` of this host is running (a zombie counts as dead)."""
-    if pid == os.getpid():
+    if pid == os.getpid() or os.name == "nt":  # Windows' os.kill(pid, 0) would terminate the process
         return True
     try:
         os.kill(pid, 0)
