@@ -1,0 +1,282 @@
+"""The reproduction scorecard (safepg.scorecard): tolerances, completeness, statuses, export.
+
+The rows are built from a tiny store: every experiment the scorecard reads, scaled to 2
+seeds and a few thousand trajectories (the cart-pole runs start from theta = 0 instead of
+the baseline, so no baseline search is needed). The numbers are meaningless at that scale;
+what is tested is that every printed result gets a row, that the status follows the
+stated rule, that every row links to a section of the book, and that the files round-trip.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from safepg import scorecard as sc
+from safepg import theory
+from safepg.experiments import get_experiment, scaled
+
+BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2d", "cartpole", "errata"}
+
+
+def tiny_experiments() -> dict:
+    exps = {n: scaled(get_experiment(n), seeds=2, budget=4000) for n in sc.NEEDED}
+    exps["table-5.1"] = scaled(get_experiment("table-5.1"), seeds=2, budget=10_000)  # >= its largest batch
+    for n in sc.RANGE_VARIANTS:
+        try:
+            exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
+        except ValueError:
+            continue
+    exps["cartpole-baseline"] = scaled(get_experiment("cartpole-baseline"), seeds=2, budget=8000)
+    e54 = exps["table-5.4"]
+    exps["table-5.4"] = replace(e54, configs=tuple(replace(c, warm_start=None, theta0=(0.0,) * 4, budget=8000)
+                                                   for c in e54.configs))
+    return exps
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    root = tmp_path_factory.mktemp("store")
+    exps = tiny_experiments()
+    rows = sc.scorecard(root, run=True, experiments=exps, jobs=1)
+    return root, exps, rows
+
+
+@pytest.fixture(scope="module")
+def rows(store):
+    return store[2]
+
+
+def by_id(rows):
+    return {r.id: r for r in rows}
+
+
+# ------------------------------------------------------------------ tolerances
+@pytest.mark.parametrize("printed, half", [("-0.59", 0.005), ("-13.21", 0.005), ("-0.588", 0.0005),
+                                           ("1.4e-06", 5e-8), ("-0.014676", 5e-7), ("72", 0.5), ("2500", 50),
+                                           ("500", 50), ("0.16", 0.005), ("-422.616", 0.0005), ("0", 0.5)])
+def test_half_unit_of_the_last_printed_digit(printed, half):
+    assert sc.half_unit(printed) == pytest.approx(half)
+
+
+def test_half_unit_refuses_text():
+    with pytest.raises(ValueError, match="printed"):
+        sc.half_unit("about 5")
+
+
+def test_rounding_rule_boundaries():
+    assert sc.within_rounding(-0.585, "-0.59") and sc.within_rounding(-0.595, "-0.59")
+    assert not sc.within_rounding(-0.5849, "-0.59") and not sc.within_rounding(-0.5951, "-0.59")
+    # A printed 0 (the coordinate step's off-diagonal entries) must be exactly 0.
+    assert sc.within_rounding(0.0, "0") and not sc.within_rounding(1e-12, "0")
+
+
+def test_interval_rules_boundaries():
+    assert sc.intervals_overlap([-1.0, -0.5], [-0.5, 0.0])  # touching ends overlap
+    assert not sc.intervals_overlap([-1.0, -0.51], [-0.5, 0.0])
+    assert sc.intervals_overlap([-9.6619, -9.6627], [-9.6626, -9.6600])  # swapped ends as printed
+    assert sc.in_widened_interval("-20.50", [-20.495, -20.40])  # widened by 0.005
+    assert not sc.in_widened_interval("-20.50", [-20.494, -20.40])
+
+
+def test_ratio_rule_is_five_points():
+    assert sc.within_points(0.55, 0.50) and sc.within_points(0.45, 0.50)
+    assert not sc.within_points(0.5501, 0.50) and not sc.within_points(0.4499, 0.50)
+
+
+def test_seed_range_and_order_rules():
+    assert sc.in_seed_range([-0.0274, -0.02745], "-0.0275")  # -0.02745 - 0.00005 reaches it
+    assert not sc.in_seed_range([-0.0274, -0.02744], "-0.0275")
+    assert sc.in_seed_range([71.0, 110.0], "72") and not sc.in_seed_range([73.0, 110.0], "72")
+    assert sc.in_seed_range([0.0, 0.0], "0") and not sc.in_seed_range([0.0, 1e-9], "0")
+    assert not sc.in_seed_range([], "72")
+    assert sc.order_of_magnitude(1e-5) == -5 and sc.order_of_magnitude(9.99e-6) == -6
+    assert sc.order_of_magnitude(6.19e-6) == -6
+    with pytest.raises(ValueError, match="x must"):
+        sc.order_of_magnitude(0.0)
+
+
+def test_every_rule_is_stated():
+    assert set(sc.RULES) >= {"closed-form", "rounded", "ci-overlap", "ci-contains", "ratio-points", "seed-range",
+                             "order", "set"}
+    assert all(len(text) > 40 for text in sc.RULES.values())
+
+
+# ------------------------------------------------------------------ statuses
+def test_status_follows_rule_and_note(monkeypatch):
+    monkeypatch.setitem(sc.NOTES, "x/explained", sc.Note("Because of {why}.", "lqg1d", "Table 5.1"))
+    monkeypatch.setitem(sc.NOTES, "x/known", sc.Note("Open: {why}.", "lqg1d", "Table 5.2", explains=False))
+    b = sc._Builder()
+    b.values["why"] = "a reason"
+    common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
+                  rule="rounded", page="lqg2d", heading="Table 5.3")
+    b.add(id="x/ok", ok=True, **common)
+    b.add(id="x/explained", ok=False, **common)
+    b.add(id="x/known", ok=False, **common)
+    b.add(id="x/unknown", ok=False, **common)
+    b.add(id="x/missing", ok=None, **common)
+    b.add(id="x/explained", ok=None, **common)  # no runs: nothing was compared, whatever the note says
+    got = [(r.status, r.explanation) for r in b.rows]
+    assert got[0] == ("reproduced", "")
+    assert got[1] == ("differs (explained)", "Because of a reason.")
+    assert got[2] == ("open", "Open: a reason.")
+    assert got[3] == ("open", "")
+    assert got[4][0] == "open" and "Not computed" in got[4][1]
+    assert got[5][0] == "open"
+    # A failing row links where its explanation points; a reproduced one where it is discussed.
+    assert b.rows[0].link.startswith("lqg2d.html#") and b.rows[1].link.startswith("lqg1d.html#table-5-1")
+    with pytest.raises(ValueError, match="rule"):
+        b.add(id="x/bad", ok=True, **{**common, "rule": "nope"})
+
+
+def test_status_is_the_rule_applied(rows):
+    for r in rows:
+        assert r.status in sc.STATUSES
+        if r.status == "differs (explained)":
+            assert r.explanation, r.id
+        if r.rule == "ratio-points" and r.ours_value is not None:
+            ok = abs(r.ours_value - r.thesis_value) * 100 <= sc.RATIO_POINTS + 1e-9
+            assert (r.status == "reproduced") == ok, r.id
+        if r.rule == "ci-overlap" and r.ours_ci95 is not None:
+            lo, hi = sorted(r.fields["thesis_ci95"])
+            ok = r.ours_ci95[0] <= hi and lo <= r.ours_ci95[1]
+            assert (r.status == "reproduced") == ok, r.id
+
+
+def test_theory_rows_follow_safepg_theory(rows):
+    ids = by_id(rows)
+    for v in theory.verified():
+        assert ids[f"theory/{v.id}"].status == "reproduced", v.id
+    for e in theory.errata():
+        if e.kind in ("reference", "proof"):
+            assert f"theory/{e.id}" not in ids
+        else:
+            r = ids[f"theory/{e.id}"]
+            assert r.status == "differs (explained)" and r.link.startswith("errata.html"), e.id
+    star = ids["theory/thm_4_3_2_improvement"]
+    assert "393" in star.thesis and "4·c" in star.difference
+    alpha = ids["theory/thm_4_3_2_alpha"]
+    text = alpha.thesis.replace("·", "*").replace("^", "**").replace("√17", "sqrt(17)")
+    assert sp.sympify(text, locals={"c": theory.c}) == (13 - 3 * sp.sqrt(17)) / (4 * theory.c)
+
+
+# ------------------------------------------------------------------ completeness
+def test_every_printed_result_has_a_row(store):
+    _, exps, rows = store
+    ids = by_id(rows)
+    assert len(ids) == len(rows), "row ids must be unique"
+    t51 = exps["table-5.1"]
+    for c in t51.configs:
+        r = ids[f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"]
+        assert r.thesis_value == t51.thesis[c.name]["improvement_ratio"]
+    assert sum(i.startswith("table-5.1/") for i in ids) == 24
+    t52 = exps["table-5.2"]
+    got52 = {(r.fields["estimator"], r.fields["bound"], r.fields["empirical_range"], r.fields["delta"]): r
+             for r in rows if r.id.startswith("table-5.2/")}
+    assert len(got52) == 12
+    for c in t52.configs:
+        r = got52[(c.estimator, c.bound, c.empirical_range, c.delta)]
+        assert r.thesis_value == t52.thesis[c.name]["upsilon_bar"]
+        assert r.fields["thesis_ci95"] == list(t52.thesis[c.name]["ci95"])
+    for table, n in (("table-5.3", 3), ("table-5.4", 2)):
+        exp = exps[table]
+        for c in exp.configs:
+            assert ids[f"{table}/{c.name}/upsilon"].thesis_value == exp.thesis[c.name]["upsilon_bar"]
+            assert ids[f"{table}/{c.name}/improvement-ratio"].thesis_value == exp.thesis[c.name]["improvement_ratio"]
+        assert sum(i.startswith(f"{table}/") for i in ids) == 2 * n
+    f = exps["figures-5.5-5.6"]
+    for c in f.configs:
+        printed = np.asarray(f.thesis[c.name]["theta_final"])
+        for (i, j), p in np.ndenumerate(printed):
+            assert ids[f"section-5.2/theta-final-{c.name}/{i + 1}{j + 1}"].thesis_value == p
+        assert ids[f"figures-5.5-5.6/{c.name}/improvement-ratio"].thesis_value == 1.0
+    assert ids["section-5.3/baseline-iterations"].thesis == "72"
+    for rid in ("section-5.1/theta-star", "section-5.1/J-star", "section-5.2/theta-star", "section-5.2/J-star",
+                "section-5.1/step-order", "section-5.2/step-order", "section-5.2/batch-first",
+                "section-5.2/batch-last", "section-5.3/components", "theory/thm_4_3_2_decimal",
+                "section-5.1/improvement-ratio-adaptive"):
+        assert rid in ids
+    assert ids["section-5.2/J-star"].thesis_value == -422.616
+    assert ids["section-5.2/theta-star"].thesis_value == -0.588
+    assert set(r.group for r in rows) == set(sc.GROUPS)
+
+
+def test_closed_forms_are_ours(rows):
+    ids = by_id(rows)
+    assert ids["section-5.1/theta-star"].ours_value == pytest.approx(-0.5884, abs=1e-4)
+    assert ids["section-5.1/J-star"].ours_value == pytest.approx(-13.2068, abs=1e-4)
+    assert ids["section-5.1/theta-star"].status == "reproduced"
+    assert ids["section-5.2/theta-star"].status == "reproduced"  # with gamma = 0.9, said in the row
+    assert "0.95" in ids["section-5.2/theta-star"].explanation
+
+
+def test_missing_runs_are_open_not_reproduced(tmp_path):
+    exps = {n: scaled(e, seeds=1, budget=2000) for n, e in tiny_experiments().items()}
+    rows = sc.scorecard(tmp_path, run=False, experiments=exps)
+    measured = [r for r in rows if r.id.startswith(("table-5.", "figures-5.5", "section-5.3/"))]
+    assert measured and all(r.status == "open" and r.ours_value is None for r in measured)
+
+
+def test_unknown_experiment_name_is_refused():
+    with pytest.raises(ValueError, match="experiments"):
+        sc.scorecard(experiments={"table-9.9": get_experiment("table-5.1")})
+
+
+# ------------------------------------------------------------------ links
+def test_every_row_links_to_a_section_of_the_book(rows):
+    for r in rows:
+        m = re.fullmatch(r"([a-z_0-9]+)\.html(?:#([a-z0-9-]+))?", r.link)
+        assert m, (r.id, r.link)
+        page, anchor = m.groups()
+        assert page in BOOK_PAGES, r.id
+        assert anchor, f"{r.id} links to {page} without an anchor"
+        headings = [sc._heading_id(text) for _, text in sc._headings(page)]
+        assert anchor in headings, (r.id, r.link)
+
+
+def test_links_follow_headings(tmp_path):
+    import nbformat
+
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell("# Chapter: Table 5.9\n\n## Table 5.9 and $\\alpha$")])
+    nbformat.write(nb, tmp_path / "page.ipynb")
+    assert sc.book_link("page", "Table 5.9", tmp_path) == "page.html#table-5-9-and-alpha"  # section over title
+    assert sc.book_link("page", "Chapter", tmp_path) == "page.html#chapter-table-5-9"
+    assert sc.book_link("page", "nowhere", tmp_path) == "page.html"
+
+
+# ------------------------------------------------------------------ export
+def test_json_and_csv_round_trip(rows, tmp_path):
+    files = sc.write_scorecard(tmp_path, rows)
+    assert set(files) == {"scorecard.csv", "scorecard.json"} | {f"table-5.{k}.{x}" for k in range(1, 5)
+                                                                 for x in ("csv", "json")}
+    assert sc.read_scorecard_json(files["scorecard.json"]) == rows
+    data = json.loads(files["scorecard.json"].read_text())
+    assert data["rules"] == sc.RULES and data["counts"]["all"] == sc.counts(rows)["all"]
+    csv_rows = sc.read_csv(files["scorecard.csv"])
+    assert [d["id"] for d in csv_rows] == [r.id for r in rows]
+    for d, r in zip(csv_rows, rows):
+        assert d["status"] == r.status and d["link"] == r.link and d["thesis"] == r.thesis
+        if r.ours_value is not None:
+            assert float(d["ours_value"]) == r.ours_value
+    for k, n in ((1, 24), (2, 12), (3, 6), (4, 4)):
+        table = sc.read_csv(files[f"table-5.{k}.csv"])
+        assert len(table) == n and all(t["id"].startswith(f"table-5.{k}/") for t in table)
+        assert len(json.loads(files[f"table-5.{k}.json"].read_text())["rows"]) == n
+    t51 = sc.read_csv(files["table-5.1.csv"])
+    assert {"sigma", "N", "alpha", "thesis", "ours", "status"} <= set(t51[0])
+
+
+def test_counts_and_html(rows):
+    c = sc.counts(rows)
+    assert list(c)[:-1] == list(sc.GROUPS) and list(c)[-1] == "all"
+    assert sum(c["all"].values()) == len(rows)
+    assert sum(sum(v.values()) for g, v in c.items() if g != "all") == len(rows)
+    page = sc.summary_html(rows) + "".join(sc.group_html(rows, g) for g in sc.GROUPS)
+    assert page.count("<tr class=\"sc-row\" data-id=") == len(rows)
+    assert page.count('class="sc-scroll"') == len(sc.GROUPS) + 1 and page.count("<style>") == 1
+    assert all(f'href="{r.link}"' in page for r in rows)
