@@ -643,9 +643,14 @@ def run_experiment(
     # Starting policies first (in parallel), so no two workers compute the same one.
     starts: dict[str, list[np.ndarray]] = {}
     for dep in sorted({c.warm_start for c in exp.configs if c.warm_start is not None}):
-        dep_cfg = _warm_start_config(dep)
-        dep_recs = run_experiment(dep, seeds=exp.seeds, jobs=jobs, root=root, progress=progress)[dep_cfg.name]
-        starts[dep] = [r.theta_final for r in dep_recs]
+        dep_exp, dep_cfg = scaled(get_experiment(dep), seeds=exp.seeds), _warm_start_config(dep)
+        run_experiment(dep_exp, jobs=jobs, root=root, progress=progress)
+        # Seed by seed from its own file, so a missing seed can never shift the others.
+        dep_recs = [_stored(run_path(dep_exp, dep_cfg, k, root), dep_cfg) for k in range(exp.seeds)]
+        if any(r is None for r in dep_recs):
+            raise RuntimeError(f"warm_start {dep!r}: seeds {[k for k, r in enumerate(dep_recs) if r is None]} "
+                               "are not stored; rerun to compute them")
+        starts[dep] = [r.theta_final for r in dep_recs]  # type: ignore[union-attr]
     todo = [(c, k) for c in exp.configs for k in range(exp.seeds)
             if _stored(run_path(exp, c, k, root), c) is None]
     # Largest budgets first (the budget is the cost we know before running): a long run
@@ -659,6 +664,8 @@ def run_experiment(
                  for i, (c, k) in enumerate(todo))
         with tqdm(total=len(todo), desc=exp.name, unit="run", disable=not progress) as bar:
             for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+                if rec.interrupted:  # Ctrl-C caught by a run in this process: stop the campaign
+                    raise KeyboardInterrupt
                 c, k = todo[i]
                 _store(rec, c, run_path(exp, c, k, root))
                 bar.update()

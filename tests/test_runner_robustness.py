@@ -133,6 +133,16 @@ def test_longest_runs_are_dispatched_first(tmp_path, monkeypatch):
     assert order == [3000, 2000, 1000]
 
 
+def test_ctrl_c_inside_a_run_stops_the_campaign(tmp_path, monkeypatch):
+    """A run that caught Ctrl-C returns a partial record: the runner stops instead of going on."""
+    exp = ex.scaled(ex.get_experiment("table-5.1"), seeds=1, budget=10_000)
+    compute = ex._compute
+    monkeypatch.setattr(ex, "_compute", lambda *a: replace(compute(*a), interrupted=True))
+    with pytest.raises(KeyboardInterrupt):
+        ex.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
+    assert _runs(tmp_path) == [] and _temps(tmp_path) == []
+
+
 # ------------------------------------------------------------------ part 5: SIGKILL and two runners
 def test_resume_after_sigkill_gives_the_uninterrupted_report(tmp_path, uninterrupted, capsys, monkeypatch):
     proc = _start(tmp_path)
