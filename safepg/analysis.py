@@ -101,7 +101,18 @@ def table_upsilon(report: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
-class Table(str):
+class Markdown(str):
+    """Markdown text that renders as Markdown in notebooks and prints as its text
+    (so nbval compares the text, not an object's address)."""
+
+    def _repr_markdown_(self) -> str:
+        return str(self)
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
+class Table(Markdown):
     """A Markdown table that renders as a table in notebooks and prints as its text
     (so nbval compares the numbers, not an object's address)."""
 
@@ -112,8 +123,32 @@ class Table(str):
         return str(self)
 
 
-def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, str, str]]) -> str:
-    """A Markdown table from rows; ``columns`` holds (key, header, format spec)."""
+def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, str, str]],
+                   caption: str | None = None, name: str | None = None) -> Table:
+    """A Markdown table from rows; ``columns`` holds (key, header, format spec).
+
+    Parameters
+    ----------
+    rows : one dict per row; a missing or None value prints as "-", a list or tuple
+        (a confidence interval) as ``[a; b]``
+    columns : (key, header, format spec) per column, in order
+    caption : with a caption the table is wrapped in a MyST ``table`` directive (a colon
+        fence), so the book numbers it and ``{numref}`` can cite it; in plain Jupyter the
+        fence's lines show as text above the table
+    name : the table's label, which sets its number in the book: ``"table-5-2"`` is shown
+        as Table 5.2, ``"table-s5-1"`` (a table the thesis does not have) as Table S5.1
+        (book/_ext/thesis_numbers.py); only with a caption
+
+    Returns
+    -------
+    Table
+        The Markdown text, which renders as a table in notebooks and prints as itself.
+    """
+    if name is not None and caption is None:
+        raise ValueError("name needs a caption: only captioned tables are numbered")
+    if caption is not None and "\n" in caption.strip():
+        raise ValueError(f"caption must be one line, got {caption!r}")
+
     def fmt(v: Any, spec: str) -> str:
         if v is None:
             return "-"
@@ -125,7 +160,56 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, 
     head = "| " + " | ".join(h for _, h, _ in columns) + " |"
     sep = "|" + "|".join("---" for _ in columns) + "|"
     body = ["| " + " | ".join(fmt(r.get(k), s) for k, _, s in columns) + " |" for r in rows]
-    return Table("\n".join([head, sep, *body]))
+    table = "\n".join([head, sep, *body])
+    if caption is None:
+        return Table(table)
+    options = f":name: {name}\n" if name else ""
+    return Table(f":::{{table}} {caption.strip()}\n{options}\n{table}\n:::")
+
+
+def with_labels(rows: Sequence[dict[str, Any]], suffix: str = "") -> list[dict[str, Any]]:
+    """Copies of table rows whose ``estimator`` and ``bound`` (with ``empirical_range``)
+    hold the labels the figures use, e.g. ``"G(PO)MDP"`` and ``"Hoeffding (e.r.)"``;
+    ``suffix`` is appended to the bound label (e.g. ``", range 1280"``)."""
+    from safepg import plotting  # matplotlib only when a table is labelled
+
+    out = []
+    for r in rows:
+        r = dict(r)
+        if "bound" in r:
+            r["bound"] = plotting.bound_label(r["bound"], r.get("empirical_range", False)) + suffix
+        if "estimator" in r:
+            r["estimator"] = plotting.ESTIMATOR_LABELS[r["estimator"]]
+        out.append(r)
+    return out
+
+
+def errata_markdown(entries: Sequence[Any]) -> Markdown:
+    """The errata as Markdown, one section per entry (``safepg.theory.errata()``): where,
+    why, the printed and the corrected statement, what corrected minus printed simplifies
+    to (when both are expressions), and whether the experiments are affected.
+
+    Expressions are display formulas, so a long one scrolls inside its own box in the book
+    instead of running past the text column.
+    """
+    import sympy as sp
+
+    def block(x: Any) -> str:
+        # an expression or a LaTeX string as a display formula, a sentence as a quotation
+        if isinstance(x, sp.Basic):
+            return f"$$\n{sp.latex(x)}\n$$"
+        text = str(x)
+        return f"$$\n{text}\n$$" if any(ch in text for ch in "\\^_=") else f"> {text}"
+
+    parts = []
+    for e in entries:
+        text = [f"### {e.location}", e.explanation, "Printed:", block(e.printed), "Corrected:", block(e.corrected)]
+        if isinstance(e.printed, sp.Basic) and isinstance(e.corrected, sp.Basic):
+            diff = sp.factor(sp.simplify(e.corrected - e.printed))
+            text += ["Corrected minus printed simplifies to", block(diff)]
+        text.append(f"*Affects the experiments:* {e.affects_experiments}. {e.impact}")
+        parts.append("\n\n".join(text))
+    return Markdown("\n\n".join(parts))
 
 
 # ------------------------------------------------------------------ estimators and objectives

@@ -94,6 +94,25 @@ function safepgTicks(lo, hi, log) {
   for (let i = Math.ceil(lo / step - 1e-9); i * step <= hi + 1e-9 * step; i++) out.push(+(i * step).toPrecision(12));
   return out;
 }
+//: Width of one tick-label character at font-size 11, in SVG units (an upper estimate).
+const SAFEPG_CHAR_WIDTH = 6.5;
+function safepgTickLabels(ticks) {
+  // The shortest labels that still tell every tick apart: "1.5e7" next to "2e7" (never two
+  // "2e+7"), "1500" next to "1000". Exponent form below 1e-3 and from 1e5 on.
+  for (let digits = 0; digits <= 12; digits++) {
+    const labels = ticks.map(v => {
+      const a = Math.abs(v);
+      if (v === 0) return "0";
+      if (a >= 1e5 || a < 1e-3) {
+        const [mant, exp] = v.toExponential(digits).split("e");
+        return `${+mant}e${+exp}`;
+      }
+      return (+v.toPrecision(digits + 1)).toString();
+    });
+    if (new Set(labels).size === labels.length) return labels;
+  }
+  return ticks.map(String);
+}
 function safepgPlot(svg, spec, res) {
   // A small SVG line plot. Colours: series colours from safepg.plotting, everything else
   // currentColor, so the plot follows the page's light or dark theme.
@@ -128,19 +147,21 @@ function safepgPlot(svg, spec, res) {
     svg.appendChild(e);
     return e;
   };
-  const fmt = v => {
-    const a = Math.abs(v);
-    return (a !== 0 && (a >= 1e5 || a < 1e-3)) ? v.toExponential(0) : (+v.toPrecision(4)).toString();
-  };
   const ink = {fill: "currentColor"}, thin = {stroke: "currentColor", "stroke-opacity": 0.12};
-  for (const xv of safepgTicks(x0, x1, spec.xlog)) {
+  const xt = safepgTicks(x0, x1, spec.xlog), xl = safepgTickLabels(xt);
+  xt.forEach((xv, i) => {
     el("line", {x1: X(xv), x2: X(xv), y1: m.t, y2: Hh - m.b, ...thin});
-    el("text", {x: X(xv), y: Hh - m.b + 16, "text-anchor": "middle", "font-size": 11, ...ink}, fmt(xv));
-  }
-  for (const yv of safepgTicks(y0, y1, spec.ylog)) {
+    // A label at either end is anchored inside the plot instead of centred across its edge.
+    const half = SAFEPG_CHAR_WIDTH * xl[i].length / 2;
+    const anchor = X(xv) + half > W ? "end" : X(xv) - half < 0 ? "start" : "middle";
+    const x = anchor === "end" ? W - 1 : anchor === "start" ? 1 : X(xv);
+    el("text", {x, y: Hh - m.b + 16, "text-anchor": anchor, "font-size": 11, ...ink, class: "safepg-tick"}, xl[i]);
+  });
+  const yt = safepgTicks(y0, y1, spec.ylog), yl = safepgTickLabels(yt);
+  yt.forEach((yv, i) => {
     el("line", {x1: m.l, x2: W - m.r, y1: Y(yv), y2: Y(yv), ...thin});
-    el("text", {x: m.l - 6, y: Y(yv) + 4, "text-anchor": "end", "font-size": 11, ...ink}, fmt(yv));
-  }
+    el("text", {x: m.l - 6, y: Y(yv) + 4, "text-anchor": "end", "font-size": 11, ...ink, class: "safepg-tick"}, yl[i]);
+  });
   el("rect", {x: m.l, y: m.t, width: W - m.l - m.r, height: Hh - m.t - m.b, fill: "none",
               stroke: "currentColor", "stroke-opacity": 0.4});
   el("text", {x: (W + m.l) / 2, y: Hh - 6, "text-anchor": "middle", "font-size": 12, ...ink}, spec.xlabel || "");

@@ -33,6 +33,83 @@ class OfflinePage:
                                     timeout=20_000)
         self.page.evaluate("() => MathJax.startup.promise")
 
+    def set_theme(self, theme: str) -> None:
+        """Switch pydata-sphinx-theme's colour mode (``"light"`` or ``"dark"``) as its toggle does."""
+        self.page.evaluate("t => { const d = document.documentElement.dataset; d.theme = t; d.mode = t; }", theme)
+
+    def audit(self) -> dict[str, Any]:
+        """Page-wide layout facts (see :data:`AUDIT_JS`): what sticks out of the main column,
+        what is clipped, the visible code and the numbered captions."""
+        return self.page.evaluate(AUDIT_JS)
+
     def values(self, index: int = 0) -> dict:
         """The JSON an explorer writes after each redraw (its ``.safepg-values`` element)."""
         return json.loads(self.page.locator(".safepg-values").nth(index).text_content())
+
+
+#: Layout audit of a book page, run in the browser. Returns
+#: ``pageOverflow`` (the document scrolls sideways: scrollWidth - clientWidth, px),
+#: ``overflowing`` (outermost elements whose box leaves the main column and that no
+#: scrolling box inside the column contains), ``clipped`` (boxes with ``overflow-x:
+#: hidden`` whose content is cut off), ``scrollNoCue`` (boxes that scroll sideways but were
+#: not given the ``safepg-scrollable`` class, i.e. no visible scroll cue), ``code`` (each
+#: visible code cell: its source, its number of lines, how many are wider than the box and
+#: how many of those are cut off: neither wrapped nor in a box that scrolls with a cue) and
+#: ``captions`` (the numbers of the numbered figures and tables, e.g. "Figure 5.3").
+AUDIT_JS = r"""() => {
+  const art = document.querySelector('article.bd-article') || document.querySelector('main');
+  const A = art.getBoundingClientRect();
+  const shown = e => (e.checkVisibility ? e.checkVisibility({checkVisibilityCSS: true}) : !!e.offsetParent)
+                     && e.getBoundingClientRect().width > 0;
+  const ox = e => getComputedStyle(e).overflowX;
+  const skip = e => e.closest('mjx-assistive-mml, .visually-hidden, .sr-only, [hidden], .headerlink');
+  const outside = r => r.right > A.right + 1 || r.left < A.left - 1;
+  const describe = e => (e.tagName.toLowerCase() + (e.className && typeof e.className === 'string'
+                          ? '.' + e.className.trim().split(/\s+/).slice(0, 2).join('.') : '')
+                         + ' ' + (e.textContent || '').trim().slice(0, 40));
+  const overflowing = [];
+  for (const el of art.querySelectorAll('*')) {
+    if (skip(el)) continue;
+    const r = el.getBoundingClientRect();
+    if (r.width === 0 || r.height === 0 || !outside(r)) continue;
+    // contained by a box inside the column that scrolls or clips?
+    let p = el.parentElement, contained = false;
+    while (p && p !== art) {
+      if (ox(p) !== 'visible' && !outside(p.getBoundingClientRect())) { contained = true; break; }
+      p = p.parentElement;
+    }
+    if (contained) continue;
+    const parent = el.parentElement;
+    if (parent && parent !== art && outside(parent.getBoundingClientRect()) && ox(parent) === 'visible') continue;
+    overflowing.push({what: describe(el), left: Math.round(r.left - A.left), right: Math.round(r.right - A.right)});
+  }
+  const clipped = [], scrollNoCue = [];
+  for (const el of art.querySelectorAll('*')) {
+    if (skip(el) || el.clientWidth < 20 || !shown(el)) continue;
+    if (el.scrollWidth <= el.clientWidth + 1) continue;
+    const o = ox(el);
+    if (o === 'hidden' || o === 'clip') clipped.push({what: describe(el), by: el.scrollWidth - el.clientWidth});
+    else if ((o === 'auto' || o === 'scroll') && !el.classList.contains('safepg-scrollable'))
+      scrollNoCue.push({what: describe(el), by: el.scrollWidth - el.clientWidth});
+  }
+  const canvas = document.createElement('canvas').getContext('2d');
+  const code = [];
+  for (const cell of art.querySelectorAll('div.cell')) {
+    const input = cell.querySelector('.cell_input pre');
+    if (!input || !shown(input)) continue;
+    const cs = getComputedStyle(input);
+    canvas.font = `${cs.fontSize} ${cs.fontFamily}`;
+    const room = input.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+    const lines = input.textContent.replace(/\n$/, '').split('\n');
+    const wide = lines.filter(l => canvas.measureText(l).width > room + 1).length;
+    const wraps = /pre-wrap|break-spaces/.test(cs.whiteSpace);
+    const cued = input.classList.contains('safepg-scrollable') || !!input.closest('.safepg-scrollable');
+    code.push({source: input.textContent, lines: lines.length, wide, clippedLines: wraps || cued ? 0 : wide});
+  }
+  const captions = [...art.querySelectorAll('figure .caption-number, table caption .caption-number, '
+                                            + 'div.figure .caption-number')]
+    .filter(e => shown(e)).map(e => e.textContent.trim().replace(/[\s:.]+$/, ''));
+  const de = document.documentElement;
+  return {pageOverflow: Math.max(0, de.scrollWidth - de.clientWidth), column: [Math.round(A.left), Math.round(A.right)],
+          overflowing, clipped, scrollNoCue, code, captions};
+}"""

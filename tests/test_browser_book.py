@@ -7,10 +7,21 @@ vendored MathJax without a TeX error, and every image decoded. The 1-D LQG explo
 then moved with the keyboard and its plotted numbers are compared with the closed form
 of SETTINGS.md, written out here independently of safepg, and with safepg's own.
 Screenshots (light and dark theme) go to ``_build/screenshots/``.
+
+``test_every_page_reads_well`` opens every page at a desktop (1280 px) and a phone
+(390 px) width, in the light and the dark theme, and checks what a reader sees: nothing
+sticks out of the text column and the page never scrolls sideways, nothing is cut off
+(a box that scrolls sideways carries the book's visible cue), no visible code line is
+cut off, no visible code cell only imports, figures in the dark theme sit on a light
+card, explorer axes have distinct tick labels inside the plot, and every figure and
+table number of the thesis is a caption on the page it belongs to
+(:data:`THESIS_CAPTIONS`), while our own figures and tables carry numbers that cannot be
+mistaken for the thesis's.
 """
 
 from __future__ import annotations
 
+import ast
 import json
 import re
 from pathlib import Path
@@ -194,3 +205,122 @@ def test_explorer_follows_the_theme(browser, book):
             assert _contrast(stroke, got["background"]) >= 2.5, (theme, stroke, got)
         root.screenshot(path=str(SHOTS / f"lqg-{theme}.png"))
     assert not pg.errors
+
+
+#: Every figure and table the thesis numbers, and the page of the book that reproduces it.
+THESIS_CAPTIONS = {
+    "book/adaptive_batch": ["Figure 4.1"],
+    "book/lqg1d": ["Table 5.1", "Table 5.2", "Figure 5.1", "Figure 5.2", "Figure 5.3", "Figure 5.4"],
+    "book/lqg2d": ["Figure 5.5", "Figure 5.6", "Figure 5.7", "Table 5.3", "Figure 5.8"],
+    "book/cartpole": ["Figure 5.9", "Table 5.4"],
+}
+#: A caption number of our own: a letter prefix (S for supplementary, E for the errata page).
+OUR_NUMBER = re.compile(r"^(Figure|Table) [A-Z]+\d*\.\d+$")
+WIDTHS = (1280, 390)
+
+
+def is_setup_cell(source: str) -> bool:
+    """A code cell that mostly imports: more than half of its statements are imports."""
+    try:
+        body = ast.parse(source).body
+    except SyntaxError:
+        return False
+    return bool(body) and 2 * sum(isinstance(n, ast.Import | ast.ImportFrom) for n in body) > len(body)
+
+
+def _explorer_axes(pg: OfflinePage) -> list[str]:
+    """Problems of the explorers' tick labels: fewer than two per plot, two equal labels on
+    one axis, overlapping labels, or a label outside its plot."""
+    return pg.page.evaluate(r"""() => {
+      const bad = [];
+      document.querySelectorAll('.safepg-explorer svg[data-plot]').forEach((svg, k) => {
+        if (!svg.querySelector('path.safepg-series')) return;  // "no data for this choice"
+        const S = svg.getBoundingClientRect();
+        const ticks = [...svg.querySelectorAll('text.safepg-tick')].map(t => ({t: t.textContent, r: t.getBoundingClientRect()}));
+        if (ticks.length < 2) { bad.push(`plot ${k}: ${ticks.length} tick labels`); return; }
+        for (const a of ticks) {
+          if (a.r.left < S.left - 1 || a.r.right > S.right + 1 || a.r.top < S.top - 1 || a.r.bottom > S.bottom + 1)
+            bad.push(`plot ${k}: tick "${a.t}" outside the plot`);
+        }
+        const low = Math.max(...ticks.map(b => b.r.bottom));  // the x axis's labels are the lowest
+        for (const axis of [ticks.filter(a => low - a.r.bottom < 2), ticks.filter(a => low - a.r.bottom >= 2)]) {
+          const texts = axis.map(a => a.t);
+          if (new Set(texts).size !== texts.length) bad.push(`plot ${k}: repeated tick labels ${texts}`);
+          for (let i = 0; i < axis.length; i++) for (let j = i + 1; j < axis.length; j++) {
+            const p = axis[i].r, q = axis[j].r;
+            if (p.left < q.right && q.left < p.right && p.top < q.bottom && q.top < p.bottom)
+              bad.push(`plot ${k}: tick labels "${axis[i].t}" and "${axis[j].t}" overlap`);
+          }
+        }
+      });
+      return bad;
+    }""")
+
+
+def _dark_figures(pg: OfflinePage) -> list[str]:
+    """Figures (cell-output images) without a light card behind them in the dark theme."""
+    backgrounds = pg.page.evaluate("""() => [...document.querySelectorAll('.bd-article .cell_output img')]
+        .map(i => [i.src.split('/').pop(), getComputedStyle(i).backgroundColor])""")
+    return [src for src, bg in backgrounds if "rgba(0, 0, 0, 0)" in bg or _luminance(bg) < 0.8]
+
+
+def test_every_page_reads_well(browser, book):
+    """The page-wide reading checks of issue 11 (see the module docstring), on every page of
+    ``_toc.yml``, at 1280 and 390 px, in the light and the dark theme."""
+    problems: dict[str, Any] = {}
+    captions_by_page: dict[str, list[str]] = {}
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    for name in toc_pages():
+        path = book / f"{name}.html"
+        for width in WIDTHS:
+            pg = OfflinePage(browser, path, width=width, height=900)
+            pg.typeset()
+            pg.page.wait_for_function("() => document.readyState === 'complete'")
+            pg.page.wait_for_timeout(400)  # the scroll-cue script runs once MathJax is done
+            for theme in ("light", "dark"):
+                pg.set_theme(theme)
+                a = pg.audit()
+                where = f"{name} @{width}px {theme}"
+                bad: dict[str, Any] = {}
+                if a["pageOverflow"]:
+                    bad["page scrolls sideways by (px)"] = a["pageOverflow"]
+                for key, label in (("overflowing", "sticks out of the column"), ("clipped", "cut off"),
+                                   ("scrollNoCue", "scrolls sideways with no cue")):
+                    if a[key]:
+                        bad[f"{len(a[key])} boxes {label}"] = [
+                            f"{e['what']} ({e.get('by', max(e.get('right', 0), -e.get('left', 0)))} px)"
+                            for e in a[key][:4]]
+                cut = [c["source"][:60] for c in a["code"] if c["clippedLines"]]
+                if cut:
+                    bad["code cells with lines cut off"] = cut
+                setup = [c["source"][:60] for c in a["code"] if is_setup_cell(c["source"])]
+                if setup:
+                    bad["visible code cells that only import"] = setup
+                if theme == "dark":
+                    light_less = _dark_figures(pg)
+                    if light_less:
+                        bad["figures without a light card in the dark theme"] = light_less
+                axes = _explorer_axes(pg)
+                if axes:
+                    bad["explorer axes"] = axes
+                if bad:
+                    problems[where] = bad
+                if width == WIDTHS[0] and theme == "light":
+                    captions_by_page[name] = a["captions"]
+                pg.page.screenshot(path=str(SHOTS / f"{name.split('/')[-1]}-{width}-{theme}.png"), full_page=True)
+            assert not pg.errors, (name, pg.errors)
+            pg.page.close()
+    # every thesis number on its page, once; every other number visibly ours
+    thesis_numbers = {n for numbers in THESIS_CAPTIONS.values() for n in numbers}
+    for name, captions in captions_by_page.items():
+        expected = THESIS_CAPTIONS.get(name, [])
+        missing = [n for n in expected if captions.count(n) != 1]
+        misplaced = [n for n in captions if n in thesis_numbers and n not in expected]
+        unclear = [n for n in captions if n not in thesis_numbers and not OUR_NUMBER.match(n)]
+        for label, items in (("thesis numbers missing (or repeated)", missing),
+                             ("thesis numbers on the wrong page", misplaced),
+                             ("numbers that are neither the thesis's nor marked as ours", unclear)):
+            if items:
+                problems.setdefault(name, {})[label] = items
+    assert set(THESIS_CAPTIONS) <= set(captions_by_page), "a page of THESIS_CAPTIONS is not in _toc.yml"
+    assert not problems, json.dumps(problems, indent=1, ensure_ascii=False)

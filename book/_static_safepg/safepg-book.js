@@ -1,0 +1,55 @@
+// safepg book: mark every box of the text column that scrolls sideways (a wide table, a long
+// formula, a long printed line) with the class safepg-scrollable and add a visible
+// "scroll sideways" cue below it; the cue goes away when the box fits. Reruns after MathJax
+// has typeset the page and whenever the window is resized.
+(function () {
+  "use strict";
+  const HINT = "safepg-scroll-hint";
+  const hints = new WeakMap();  // scrolling box -> its cue element
+
+  function scrollsSideways(el) {
+    const o = getComputedStyle(el).overflowX;
+    return (o === "auto" || o === "scroll") && el.scrollWidth > el.clientWidth + 1 && el.clientWidth > 0;
+  }
+
+  function atEnd(el) {
+    el.classList.toggle("safepg-at-end", el.scrollLeft + el.clientWidth >= el.scrollWidth - 1);
+  }
+
+  function mark() {
+    const article = document.querySelector("article.bd-article") || document.querySelector("main");
+    if (!article) return;
+    for (const el of article.querySelectorAll("*")) {
+      if (el.classList.contains(HINT)) continue;
+      const scrolls = scrollsSideways(el);
+      const had = el.classList.contains("safepg-scrollable");
+      if (scrolls && !had) {
+        el.classList.add("safepg-scrollable");
+        const hint = document.createElement("div");
+        hint.className = HINT;
+        hint.setAttribute("aria-hidden", "true");
+        hint.textContent = "scroll sideways to see all of it";
+        // A formula's box sits in Sphinx's div.math (a flex row): the cue goes below that.
+        const anchor = el.tagName === "MJX-CONTAINER" && el.parentElement.classList.contains("math")
+          ? el.parentElement : el;
+        anchor.insertAdjacentElement("afterend", hint);
+        hints.set(el, hint);
+        el.addEventListener("scroll", () => atEnd(el), {passive: true});
+      } else if (!scrolls && had) {
+        el.classList.remove("safepg-scrollable", "safepg-at-end");
+        if (hints.has(el)) hints.get(el).remove();
+        hints.delete(el);
+      }
+      if (scrolls) atEnd(el);
+    }
+  }
+
+  let timer = null;
+  function later() { clearTimeout(timer); timer = setTimeout(mark, 150); }
+  window.addEventListener("load", () => {
+    mark();
+    if (window.MathJax && MathJax.startup && MathJax.startup.promise) MathJax.startup.promise.then(mark);
+  });
+  window.addEventListener("resize", later);
+  document.addEventListener("DOMContentLoaded", later);
+})();

@@ -1,0 +1,53 @@
+"""The explorers' axis ticks (``safepgTicks``, ``safepgTickLabels`` in safepg/explorer.py),
+evaluated with Node.js: every label distinct, and as short as that allows.
+
+The browser test (test_browser_book.py) checks the drawn labels stay inside each plot.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+
+import pytest
+
+from safepg.explorer import _RUNTIME_JS
+
+NODE = shutil.which("node")
+pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+
+
+def axis(lo: float, hi: float, log: bool) -> tuple[list[float], list[str]]:
+    """Tick values and labels of an axis from lo to hi (for a log axis, lo and hi are log10)."""
+    script = (_RUNTIME_JS + f"\nconst t = safepgTicks({lo}, {hi}, {str(log).lower()});"
+              "\nconsole.log(JSON.stringify([t, safepgTickLabels(t)]));")
+    out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
+    ticks, labels = json.loads(out)
+    return ticks, labels
+
+
+@pytest.mark.parametrize("lo, hi, log", [
+    (0, 3e7, False),          # the batch-size explorer's trajectories axis
+    (1, 3e7, False),
+    (0, 1.2, False), (-120, 0, False), (1000, 2500, False), (-0.95, -0.35, False),
+    (2, 5, True), (5, 7.5, True), (-7, -2, True), (0.3, 0.9, True),
+])
+def test_labels_are_distinct_and_read_back(lo, hi, log):
+    ticks, labels = axis(lo, hi, log)
+    assert len(ticks) >= 2
+    assert len(set(labels)) == len(labels), labels
+    for v, text in zip(ticks, labels):
+        # each label reads back as its tick's value to the precision the labels need
+        assert float(text) == pytest.approx(v, rel=0.05, abs=1e-12), (v, text)
+
+
+def test_trajectory_axis_labels():
+    """The defect of the old axis: 1.5e7 and 2.5e7 were printed as "2e+7" and "3e+7"."""
+    ticks, labels = axis(0, 3e7, False)
+    assert labels == ["0", "5e6", "1e7", "1.5e7", "2e7", "2.5e7", "3e7"]
+
+
+def test_shortest_labels():
+    assert axis(0, 1.2, False)[1] == ["0", "0.2", "0.4", "0.6", "0.8", "1", "1.2"]
+    assert axis(3, 5, True)[1][:3] == ["1000", "2000", "5000"]
