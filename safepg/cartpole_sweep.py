@@ -52,6 +52,8 @@ VANILLA_ALPHA = 0.01
 #: share of the vanilla step: 1/1000 of alpha = 0.01, i.e. c <= 5 * 10^4. Below it, 100
 #: iterations at the largest safe step move theta less than a tenth of one vanilla step.
 CAN_MOVE_SHARE = 1e-3
+#: The penalty constant below which the step can move: 1 / (2 CAN_MOVE_SHARE VANILLA_ALPHA) = 5 * 10^4.
+CAN_MOVE_C = 1.0 / (2.0 * CAN_MOVE_SHARE * VANILLA_ALPHA)
 #: A run "learns" when its batch-average return over the last quarter of its trajectories
 #: exceeds its first batch's by more than this many steps (a batch of 4000 episodes of
 #: about 185 steps has a standard error near 0.5 steps).
@@ -230,6 +232,6 @@ def sweep_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-__all__ = ["CAN_MOVE_SHARE", "LEARNS_MARGIN", "THESIS", "baseline_experiments", "drawdown", "late_minus_first",
+__all__ = ["CAN_MOVE_C", "CAN_MOVE_SHARE", "LEARNS_MARGIN", "THESIS", "VANILLA_ALPHA", "baseline_experiments", "drawdown", "late_minus_first",
            "load_sweep", "max_safe_step", "penalty_grid", "relative_move", "run_sweep", "smallest_c_by_gamma",
            "sweep_summary", "sweep_table"]

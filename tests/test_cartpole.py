@@ -286,3 +286,24 @@ def test_works_without_gymnasium() -> None:
         "assert m.CartPole().simulate_gain(np.zeros(4), 1.0, 3, 0).n == 3\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+
+
+@pytest.mark.parametrize("pole_length", [1.0, 2.0])
+def test_semi_implicit_step_matches_gymnasium(pole_length: float) -> None:
+    rng = np.random.default_rng(21)
+    states, forces = random_states(rng, 300), rng.uniform(-10, 10, 300)
+    ours = step_dynamics(states, forces, pole_length, integrator="semi-implicit")
+    np.testing.assert_allclose(ours, gymnasium_step(states, forces, pole_length, "semi-implicit"), rtol=0, atol=1e-12)
+    # ... and it is another scheme: positions move with the new velocities.
+    assert np.abs(ours - step_dynamics(states, forces, pole_length)).max() > 1e-3
+    np.testing.assert_array_equal(ours[:, 0], states[:, 0] + 0.02 * ours[:, 1])
+    with pytest.raises(ValueError, match="^integrator "):
+        step_dynamics(states, forces, integrator="rk4")
+
+
+def test_gymnasium_env_uses_the_task_settings() -> None:
+    env = ContinuousCartPoleEnv(integrator="semi-implicit", tau=0.01)
+    s0 = np.array([0.01, -0.02, 0.03, 0.01])
+    env.reset(options={"state": s0})
+    obs, *_ = env.step(np.array([3.0]))
+    np.testing.assert_array_equal(obs, step_dynamics(s0, 3.0, tau=0.01, integrator="semi-implicit"))

@@ -153,3 +153,35 @@ def test_fused_bad_input() -> None:
         task.gradient_batch(LinearGaussianPolicy(np.zeros(3), 1.0), 10, 0)
     with pytest.raises(ValueError, match="^policy"):
         task.gradient_batch(np.zeros(4), 10, 0)
+
+
+
+def test_sweep_settings_at_their_defaults_change_no_bit() -> None:
+    """The sweep's settings spelled out at their default values give the default task's exact bits
+    (the Euler branch of the kernel is the one the default takes)."""
+    explicit = CartPole(integrator="euler", feature_scale=None, reward_bound=1.0, action_space_volume=None,
+                        horizon_term="effective")
+    assert explicit == CartPole()
+    for task, K, sig in CASES.values():
+        pol = LinearGaussianPolicy(K, sig)
+        spelled = CartPole.from_name(task.setting_name() + "[integrator=euler]")
+        for est in ("gpomdp", "reinforce"):
+            a, b = task.gradient_batch(pol, 700, 7, est), spelled.gradient_batch(pol, 700, 7, est)
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    # The unit scale is the identity, bit for bit (x / 1 = x).
+    task, K, sig = CASES["mixed"]
+    unit = CartPole(feature_scale=(1.0, 1.0, 1.0, 1.0))
+    pol = LinearGaussianPolicy(K, sig)
+    a, b = task.gradient_batch(pol, 700, 3), unit.gradient_batch(pol, 700, 3)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    assert np.array_equal(task.simulate(pol, 50, 1).features, unit.simulate(pol, 50, 1).features)
+
+def test_semi_implicit_kernel_flag() -> None:
+    """The kernel's semi_implicit flag integrates like step_dynamics(..., integrator="semi-implicit")."""
+    task = CartPole(integrator="semi-implicit")
+    pol = LinearGaussianPolicy(np.array([-1.0, 0.0, 30.0, 5.0]), 5.0)
+    for estimator in ("gpomdp", "reinforce"):
+        samples, returns = task.gradient_batch(pol, 700, 12, estimator)
+        ref, lengths = reference(task, pol, 700, 12, estimator, True, "clipped")
+        np.testing.assert_allclose(samples, ref, rtol=1e-9, atol=1e-9)
+        np.testing.assert_array_equal(returns, lengths)
