@@ -204,7 +204,7 @@ def test_only_temp_files_of_dead_writers_are_removed(tmp_path):
     alive = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     zombie = subprocess.Popen([sys.executable, "-c", "pass"])
     try:
-        time.sleep(0.5)  # the zombie has exited but is not reaped yet
+        os.waitid(os.P_PID, zombie.pid, os.WEXITED | os.WNOWAIT)  # exited, left unreaped: a zombie
         host, folder = ex.socket.gethostname(), tmp_path / "exp" / "cfg"
         folder.mkdir(parents=True)
         names = {
