@@ -363,7 +363,7 @@ function safepgLiveLearner(root, spec, learnerSrc) {
       const out = root.querySelector(`[data-show="${inp.dataset.param}"]`);
       if (out) out.textContent = inp.value;
     });
-    const msg = {job: job, task: data.task, every: 80, runs: configs(p)};
+    const msg = {job: job, task: data.task, every: 150, runs: configs(p)};
     st = {job: job, p: p, runs: {}, done: false, elapsed: 0, t0: performance.now(), worker: false, error: null};
     if (url && typeof Worker !== "undefined") {
       try {

@@ -255,10 +255,14 @@ def test_normals_are_standard_normal(tmp_path):
 
 # --------------------------------------------------------------------------- stochastic parts
 SEEDS = 30
-#: (bound, empirical range, estimator, sigma): at least Chebyshev and Bernstein (e.r.), both
-#: estimators, two sigmas (issue 12).
+#: (bound, empirical range, estimator, sigma): Chebyshev and Bernstein (e.r.), both estimators,
+#: two sigmas (issue 12), every combination: ``python tests/test_learner_js.py`` (about 6 CPU minutes).
 STAT_CONFIGS = [(b, er, est, s) for b, er in (("chebyshev", False), ("bernstein", True))
                 for est in ("gpomdp", "reinforce") for s in (1.0, 0.5)]
+#: What the test suite runs: half of them, a 2^(3-1) design in which each bound meets each
+#: estimator and each sigma once (every pair of levels is covered), to keep the suite short.
+TEST_CONFIGS = [("chebyshev", False, "gpomdp", 1.0), ("chebyshev", False, "reinforce", 0.5),
+                ("bernstein", True, "gpomdp", 0.5), ("bernstein", True, "reinforce", 1.0)]
 METRICS = (("J_at_1e5", "mean J at 10^5"), ("J_at_1e6", "mean J at 10^6"), ("iterations", "mean iterations"))
 
 
@@ -300,7 +304,7 @@ def agreement(bound: str, er: bool, estimator: str, sigma: float, seeds: int = S
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("bound,er,estimator,sigma", STAT_CONFIGS)
+@pytest.mark.parametrize("bound,er,estimator,sigma", TEST_CONFIGS)
 def test_runs_agree_statistically(bound, er, estimator, sigma):
     for row in agreement(bound, er, estimator, sigma):
         assert row["inside"], row
