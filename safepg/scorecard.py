@@ -65,6 +65,8 @@ GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5
 PRINTED: dict[str, Any] = {
     # Section 5.1: "theta* ~ -0.59, corresponding to expected performance J(theta*) ~ -13.21".
     "lqg1d_theta_star": "-0.59",
+    # Section 5.1, Table 5.1: "starting from theta = -0.55".
+    "table_5_1_theta0": "-0.55",
     "lqg1d_J_star": "-13.21",
     # Section 5.1: "step sizes ... of the order of 10^-5" (also "In all the experiments").
     "lqg1d_step_order": -5,
@@ -130,9 +132,8 @@ class Note:
 #: ``{...}`` fields are filled from the measured values (see :func:`_fill`).
 NOTES: dict[str, Note] = {
     "table-5.1/": Note(
-        "Open: the thesis states neither the baseline nor the number of runs averaged, and counts an update "
-        "as improving on the closed-form J, not on the simulated return the learner improves; no variant "
-        "tried reproduces the whole table.", "lqg1d", "Table 5.1", explains=False),
+        "Open: run from θ0 = {t51_theta0}, this cell is more than 5 points from the printed one; the thesis "
+        "states neither the baseline nor the number of runs averaged.", "lqg1d", "Table 5.1", explains=False),
     "table-5.2/theoretical-range": Note(
         "The range of the gradient samples behind this row is not printed; rerun, it gives {variant}, "
         "inside the printed interval.", "lqg1d", "Table 5.2"),
@@ -554,20 +555,37 @@ def _theory_rows(b: _Builder) -> None:
           explanation="The decimal is right; the guarantee it multiplies lacks a factor 1/(4c) (see the errata).")
 
 
-def _table_5_1_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any]) -> None:
+def _table_5_1_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any], variant: Experiment | None,
+                    variant_rep: Mapping[str, Any] | None) -> None:
+    """Table 5.1, cell by cell. ``variant``: the table from the other starting point (the printed
+    theta_0 when the table runs from a reconstructed one), quoted beside each cell."""
+    others = {}
+    for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
+        others[(vc.sigma, vc.batch_size, vc.alpha)] = (vc, vr)
+    printed_theta0 = PRINTED["table_5_1_theta0"]
     for c, r in zip(exp.configs, rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
         if thesis is None:
             continue
         mean, ci = _mean_ci(r["improvement_ratio"])
+        ok = None if mean is None else within_points(mean, thesis)
         rid = f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"
+        explanation = None
+        theta0 = c.theta0[0]
+        vc, vr = others.get((c.sigma, c.batch_size, c.alpha), (None, None))
+        v_mean = None if vr is None else vr["improvement_ratio"]["mean"]
+        if ok and theta0 != float(printed_theta0):
+            explanation = f"Run from θ0 = {theta0:g}, our reconstruction: the thesis prints θ0 = {printed_theta0}" + \
+                (f", from which ours is {_pct(v_mean)}." if v_mean is not None and vc.theta0[0] == float(printed_theta0)
+                 else ".")
+        b.values["t51_theta0"] = f"{theta0:g}"
         b.add(id=rid, group="Section 5.1", quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, "
               f"α = {c.alpha:.0e}", where="Table 5.1", thesis=_pct(thesis),
               ours=_pct(mean) + _ci_text(ci, lambda x: _pct(x, 1)),
-              difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
-              ok=None if mean is None else within_points(mean, thesis), rule="ratio-points",
-              page="lqg1d", heading="Table 5.1", thesis_value=thesis, ours_value=mean, ours_ci95=ci,
-              seeds=r["seeds"], fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha})
+              difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
+              rule="ratio-points", page="lqg1d", heading="Table 5.1", explanation=explanation, thesis_value=thesis,
+              ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
+              fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": theta0})
 
 
 def _range_label(r: Mapping[str, Any] | None, cfg: Any) -> str:
@@ -810,6 +828,8 @@ NEEDED = ("table-5.1", "table-5.2", "figures-5.5-5.6", "table-5.3", "cartpole-ba
 #: The variant of Table 5.2 with the other theoretical range (Lemma 4.3.3's, or the
 #: reconstructed one in older versions), when the library defines it.
 RANGE_VARIANTS = ("table-5.2-lemma-range", "table-5.2-range")
+#: The variant of Table 5.1 from the printed theta_0 (when the table runs from a reconstructed one).
+THETA0_VARIANTS = ("table-5.1-printed-theta0",)
 
 
 def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mapping[str, Experiment] | None = None,
@@ -824,7 +844,8 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
         Compute the missing runs first (:func:`~safepg.experiments.run_experiment`); with
         ``False`` only stored runs are read, and rows without runs are ``"open"``.
     experiments : mapping, optional
-        Replacements for the experiments of :data:`NEEDED` (and :data:`RANGE_VARIANTS`) by
+        Replacements for the experiments of :data:`NEEDED` (and the variants
+        :data:`RANGE_VARIANTS`, :data:`THETA0_VARIANTS`) by
         name, e.g. :func:`~safepg.experiments.scaled` copies for a quick look or a test.
     jobs : int
         Parallel jobs when ``run`` (joblib's convention).
@@ -838,20 +859,24 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
         Ordered by :data:`GROUPS`, then as in the thesis.
     """
     overrides = dict(experiments or {})
-    unknown = set(overrides) - set(NEEDED) - set(RANGE_VARIANTS)
+    known = NEEDED + RANGE_VARIANTS + THETA0_VARIANTS
+    unknown = set(overrides) - set(known)
     if unknown:
-        raise ValueError(f"experiments must be keyed by names in {NEEDED + RANGE_VARIANTS}, got {sorted(unknown)}")
+        raise ValueError(f"experiments must be keyed by names in {known}, got {sorted(unknown)}")
     exps = {n: overrides.get(n) or get_experiment(n) for n in NEEDED}
     variant = next((n for n in RANGE_VARIANTS if n in overrides or n in EXPERIMENTS), None)
-    if variant is not None:
-        exps[variant] = overrides.get(variant) or get_experiment(variant)
+    t51_variant = next((n for n in THETA0_VARIANTS if n in overrides or n in EXPERIMENTS), None)
+    for n in (variant, t51_variant):
+        if n is not None:
+            exps[n] = overrides.get(n) or get_experiment(n)
     recs = {n: _records(e, root, run, jobs) for n, e in exps.items()}
     reps = {n: report(e, recs[n]) for n, e in exps.items()}
 
     b = _Builder(book=book or BOOK)
     _theory_rows(b)
     _lqg_rows(b)
-    _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"])
+    _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps.get(t51_variant or ""),
+                    reps.get(t51_variant or ""))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(variant or ""), reps.get(variant or ""))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
@@ -985,6 +1010,8 @@ table.sc-table caption{caption-side:top;text-align:left;padding:.3em .5em;font-w
 table.sc-table th,table.sc-table td{border-top:1px solid var(--pst-color-border,#ddd);padding:.3em .5em;
   vertical-align:top;text-align:left;background:transparent;color:inherit}
 table.sc-table tr.sc-note td{border-top:0;padding-top:0;font-size:.95em;color:var(--pst-color-text-muted,#555)}
+/* Notes and captions span the whole (wide) table: keep them readable in the visible part. */
+.sc-pin{position:sticky;left:.5em;max-width:min(44em,calc(100vw - 3.5rem))}
 table.sc-table td.sc-num{white-space:nowrap;font-variant-numeric:tabular-nums}
 table.sc-table td.sc-result{min-width:11em;max-width:20em}
 table.sc-table td.sc-expr{min-width:8em}
@@ -1068,8 +1095,9 @@ def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
             f'<td><a class="sc-link" href="{html.escape(r.link)}">{html.escape(_link_label(r.link))}</a></td></tr>')
         if r.explanation:
             body.append(f'<tr class="sc-note" data-for="{html.escape(r.id)}"><td colspan="{len(cols)}">'
-                        f"{html.escape(r.explanation)}</td></tr>")
-    table = (f'<table class="sc-table sc-rows"><caption>{html.escape(group)}: {line}</caption><thead>{head}</thead>'
+                        f'<div class="sc-pin">{html.escape(r.explanation)}</div></td></tr>')
+    table = (f'<table class="sc-table sc-rows"><caption><div class="sc-pin">{html.escape(group)}: {line}</div>'
+             f"</caption><thead>{head}</thead>"
              f"<tbody>{''.join(body)}</tbody></table>")
     return _wrap(table, css, group)
 
