@@ -14,7 +14,7 @@ from safepg.cartpole_sweep import (
     THESIS,
     VANILLA_ALPHA,
     drawdown,
-    late_minus_first,
+    late_minus_early,
     max_safe_step,
     penalty_grid,
     relative_move,
@@ -217,7 +217,11 @@ def record(J_hat: list[float], n: int = 4000, theta_end: float = 1.0) -> Learnin
 
 def test_run_metrics() -> None:
     rec = record([180, 190, 185, 200, 196, 199, 198, 197], theta_end=1.5)
-    assert late_minus_first(rec) == pytest.approx((198 + 197) / 2 - 180)
+    assert late_minus_early(rec) == pytest.approx((198 + 197) / 2 - 180)  # early: the first batch only
+    assert late_minus_early(rec, early=0.3) == pytest.approx((198 + 197) / 2 - (180 + 190 + 185) / 3)
+    uneven = record([180.0, 190, 200, 200])
+    uneven.batch_size[:] = (100, 900, 1000, 1000)  # the first tenth is the first two batches, weighted
+    assert late_minus_early(uneven) == pytest.approx(200 - (180 * 100 + 190 * 900) / 1000)
     assert drawdown(rec) == 5.0  # 190 -> 185 (200 -> 196 is 4)
     assert relative_move(rec, CartPole()) == pytest.approx(0.5)
     # Normalised units are undone: theta / scale.
