@@ -346,10 +346,10 @@ def _table_5_4() -> Experiment:
 # doubled pole? :mod:`safepg.cartpole_sweep` computes the penalty constant over the whole grid
 # of settings analytically and reads these runs back for the chapter.
 
-#: Trajectories per doubled-pole run of the sweep (both methods: 100 iterations of the
+#: Trajectories per doubled-pole run of the sweep (both methods: 75 iterations of the
 #: vanilla N = 4000) and seeds per setting. Small on purpose, so that the chapter's sweep costs
 #: a few minutes; ``table-5.4`` is the full-budget protocol at the default setting.
-SWEEP_BUDGET = 400_000
+SWEEP_BUDGET = 300_000
 SWEEP_SEEDS = 2
 #: Cap on a sweep baseline search: 250 iterations of N = 4000 (the thesis needed 72).
 SWEEP_BASELINE_CAP = 4000 * 250
@@ -414,7 +414,6 @@ def _sweep_settings() -> tuple[SweepSetting, ...]:
         SweepSetting("gamma=0.9+normalised", "gamma 0.9, normalised",
                      {"gamma": 0.9, "feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0},
                      warm_start="cartpole-baseline-normalised"),
-        SweepSetting("M_phi=1", "M_phi 1", constants={"feature_bound": 1.0}, plausible=False),
         SweepSetting("M_phi=0.1", "M_phi 0.1", constants={"feature_bound": 0.1}, plausible=False),
         SweepSetting("M_phi=0.03", "M_phi 0.03", constants={"feature_bound": 0.03}, plausible=False),
         SweepSetting("M_phi=0.01", "M_phi 0.01", constants={"feature_bound": 0.01}, plausible=False),
