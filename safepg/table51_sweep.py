@@ -248,8 +248,9 @@ def closed_form_j(theta: np.ndarray | float, noise: float, gamma: float = 0.9, q
     -inf where the closed loop is unstable.
     """
     t = np.asarray(theta, dtype=float)
-    den = 1 - gamma * (1 + t) ** 2
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(over="ignore"):
+        den = 1 - gamma * (1 + t) ** 2
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # a diverged run's parameters
         P = (q + r * t**2) / den
         J = -(state_bound**2 / 3) * P - noise * (r + gamma * P) / (1 - gamma)
     return np.where(den > 0, J, -np.inf)
@@ -418,7 +419,7 @@ def figure_theta0_scan(summary: Sequence[dict[str, Any]], count: Count = "all") 
     import matplotlib.pyplot as plt
 
     rows = [r for r in summary if r["count"] == count]
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 5.2), sharex=True)
     default = sorted((r for r in rows if r["variant"] == DEFAULT.label), key=lambda r: r["theta0"])
     others = [r for r in rows if r["variant"] != DEFAULT.label]
     markers = "osD^v<>phX*"
@@ -434,12 +435,14 @@ def figure_theta0_scan(summary: Sequence[dict[str, Any]], count: Count = "all") 
                     ms=6, alpha=0.8, label=lab)
         ax.axvline(PRINTED_THETA0, color="0.6", ls=":", lw=1)
         ax.axvline(RECONSTRUCTED_THETA0, color="C3", ls="--", lw=1)
+        ax.set_xticks(np.round(np.arange(-0.59, -0.549, 0.01), 2))
         ax.set_xlabel(r"starting point $\theta_0$")
         ax.set_ylabel(ylabel)
     axes[1].axhline(24, color="0.6", lw=0.8)
     axes[0].set_yscale("log")
-    axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.18), ncol=2)
-    fig.tight_layout()
+    handles, labels_ = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels_, loc="lower center", ncol=3, fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.2, 1, 1))
     return fig
 
 
