@@ -15,6 +15,7 @@ from typing import Literal
 
 import numpy as np
 
+from safepg import portable
 from safepg.constants import TaskConstants
 
 Bound = Literal["chebyshev", "hoeffding", "bernstein"]
@@ -54,7 +55,9 @@ def reinforce_variance_factor(k: TaskConstants) -> float:
     .. math:: \frac{R^2 M_\phi^2 H (1-\gamma^H)^2}{\sigma^2 (1-\gamma)^2}
     """
     g, H = k.gamma, k.H
-    return (k.R * k.M_phi * (1 - g**H) / (k.sigma * (1 - g))) ** 2 * H
+    # Powers and logs through safepg.portable: libm's last bit depends on the CPU.
+    root = k.R * k.M_phi * (1 - portable.ipow(g, H)) / (k.sigma * (1 - g))
+    return root * root * H
 
 
 def gpomdp_variance_factor(k: TaskConstants) -> float:
@@ -64,8 +67,10 @@ def gpomdp_variance_factor(k: TaskConstants) -> float:
               + H\gamma^{2H} - 2\gamma^H\frac{1-\gamma^H}{1-\gamma}\Big]
     """
     g, H = k.gamma, k.H
-    bracket = (1 - g ** (2 * H)) / (1 - g**2) + H * g ** (2 * H) - 2 * g**H * (1 - g**H) / (1 - g)
-    return (k.R * k.M_phi / (k.sigma * (1 - g))) ** 2 * bracket
+    gH, g2H = portable.ipow(g, H), portable.ipow(g, 2 * H)
+    bracket = (1 - g2H) / (1 - g * g) + H * g2H - 2 * gH * (1 - gH) / (1 - g)
+    root = k.R * k.M_phi / (k.sigma * (1 - g))
+    return root * root * bracket
 
 
 def chebyshev(delta: float, variance: float) -> ErrorBound:
@@ -76,13 +81,13 @@ def chebyshev(delta: float, variance: float) -> ErrorBound:
 
 def gradient_range_bound(k: TaskConstants) -> float:
     r"""Lemma 4.3.3: range of a gradient sample, :math:`2 H M_\phi \bar A R / (\sigma^2 (1-\gamma))`."""
-    return 2 * k.H * k.M_phi * k.A_bar * k.R / (k.sigma**2 * (1 - k.gamma))
+    return 2 * k.H * k.M_phi * k.A_bar * k.R / (k.sigma * k.sigma * (1 - k.gamma))
 
 
 def hoeffding(delta: float, grad_range: float) -> ErrorBound:
     r"""Hoeffding: :math:`d_\delta = \mathbf R\sqrt{\ln(2/\delta)/2}` (Section 4.3.2)."""
     check_delta(delta)
-    return ErrorBound(grad_range * np.sqrt(np.log(2 / delta) / 2))
+    return ErrorBound(grad_range * np.sqrt(portable.log(2 / delta) / 2))
 
 
 def bernstein(delta: float, sample_variance: float, grad_range: float) -> ErrorBound:
@@ -91,7 +96,7 @@ def bernstein(delta: float, sample_variance: float, grad_range: float) -> ErrorB
     .. math:: d_\delta = \sqrt{2 S_N \ln(3/\delta)}, \qquad f_\delta = 3\mathbf R\ln(3/\delta)
     """
     check_delta(delta)
-    log3 = np.log(3 / delta)
+    log3 = portable.log(3 / delta)
     return ErrorBound(np.sqrt(2 * sample_variance * log3), 3 * grad_range * log3)
 
 

@@ -15,6 +15,7 @@ from typing import Literal
 
 import numpy as np
 
+from safepg import portable
 from safepg.policies import LinearGaussianPolicy
 from safepg.trajectories import Trajectories
 
@@ -49,7 +50,7 @@ def reinforce_baseline(total_score: np.ndarray, returns: np.ndarray) -> np.ndarr
                        {\langle(\sum_k \nabla\log\pi_k)^2\rangle_N}
     """
     sq = total_score**2
-    return _safe_ratio(sq.T @ returns, sq.sum(axis=0))
+    return _safe_ratio(np.sum(sq * returns[:, None], axis=0), sq.sum(axis=0))  # not BLAS (safepg.portable)
 
 
 def reinforce(
@@ -62,7 +63,7 @@ def reinforce(
     """
     _check_shapes(scores, rewards)
     total_score = scores.sum(axis=1)  # (N, m)
-    returns = rewards @ (gamma ** np.arange(rewards.shape[1]))  # (N,)
+    returns = np.sum(rewards * portable.powers(gamma, rewards.shape[1]), axis=1)  # (N,)
     b = reinforce_baseline(total_score, returns) if baseline else np.zeros(scores.shape[2])
     return total_score * (returns[:, None] - b[None, :])
 
@@ -90,7 +91,7 @@ def gpomdp(
     """
     _check_shapes(scores, rewards)
     cum_score = np.cumsum(scores, axis=1)  # (N, H, m)
-    disc_rewards = rewards * (gamma ** np.arange(rewards.shape[1]))  # (N, H)
+    disc_rewards = rewards * portable.powers(gamma, rewards.shape[1])  # (N, H)
     if baseline:
         b = gpomdp_baseline(cum_score, disc_rewards)
         return np.einsum("nhm,nhm->nm", cum_score, disc_rewards[:, :, None] - b[None])

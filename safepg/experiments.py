@@ -31,18 +31,19 @@ import tempfile
 import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, replace
+from functools import cache
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from scipy import stats
 from tqdm.auto import tqdm
 
 from safepg.learning import CHECKPOINTS, LearningRecord, adaptive_pg, vanilla_pg
 
 #: Bump when a change to the library alters the numbers a run produces; stored runs with
-#: another version are recomputed.
-RESULTS_VERSION = "1"
+#: another version are recomputed. 2: every output computed in a CPU-independent order
+#: (safepg.portable): products instead of libm's pow, software log, sine and cosine.
+RESULTS_VERSION = "2"
 
 
 @dataclass(frozen=True)
@@ -690,8 +691,32 @@ def mean_ci95(values: Iterable[float]) -> dict[str, Any]:
     m = float(x.mean())
     if x.size < 2:
         return {"mean": m, "ci95": [m, m]}
-    h = float(stats.t.ppf(0.975, x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
+    h = float(t_quantile_975(x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
     return {"mean": m, "ci95": [m - h, m + h]}
+
+
+@cache
+def t_quantile_975(df: int) -> float:
+    """0.975 quantile of Student's t with ``df`` degrees of freedom.
+
+    Computed with mpmath (software arithmetic), not ``scipy.stats.t.ppf``, whose special
+    functions call libm and can differ across CPUs in the last bit of a reported interval.
+    Solves :math:`I_x(df/2, 1/2) = 0.05` for :math:`x = df / (df + t^2)`.
+    """
+    import mpmath
+
+    if int(df) != df or df < 1:
+        raise ValueError(f"df must be a positive integer, got {df}")
+    with mpmath.workdps(40):
+        a = mpmath.mpf(df) / 2
+        lo, hi = mpmath.mpf(0), mpmath.mpf(1)
+        for _ in range(80):  # bisection: I_x increases in x; x > 0.006 for df >= 1, so 2^-80 is below its ulp
+            mid = (lo + hi) / 2
+            if mpmath.betainc(a, 0.5, 0, mid, regularized=True) < mpmath.mpf("0.05"):
+                lo = mid
+            else:
+                hi = mid
+        return float(mpmath.sqrt(df * (1 - lo) / lo))
 
 
 def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,

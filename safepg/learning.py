@@ -17,6 +17,7 @@ from typing import Any, Literal, Protocol
 import numpy as np
 from tqdm.auto import tqdm
 
+from safepg import portable
 from safepg._rng import RNGLike, as_generator
 from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
 from safepg.constants import BoundedTask, TaskConstants
@@ -106,7 +107,8 @@ class LearningRecord:
     def upsilon_bar(self) -> float:
         r"""Average performance :math:`\overline\Upsilon` (Tables 5.2-5.4): the measured
         performance averaged over all trajectories (iterations weighted by batch size)."""
-        return float(self.batch_size @ self.J_hat / self.batch_size.sum())
+        # Exact sums (math.fsum), not ``@``: BLAS's dot product differs across CPUs in the last bit.
+        return portable.fsum_mean(self.J_hat, weights=self.batch_size)
 
     def improvement_ratio(self, on: Literal["J", "J_hat"] = "J") -> float:
         """Share of policy updates after which performance did not decrease.

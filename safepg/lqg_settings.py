@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from safepg import portable
 from safepg._rng import RNGLike, as_generator
 from safepg.envs.lqg import LQG
 from safepg.policies import LinearGaussianPolicy, _check_sigma
@@ -89,13 +90,14 @@ def second_moments(env: LQG, theta: np.ndarray | float, sigma: float | np.ndarra
     A, B, _, _ = env._mats
     K = env._gain(theta)
     S_pol = _check_sigma(sigma, env.dim)
-    F = A + B @ K
-    noise = B @ S_pol @ B.T
+    mm = portable.matmul  # fixed-order products: these values are printed (safepg.portable)
+    F = A + mm(B, K)
+    noise = mm(mm(B, S_pol), B.T)
     out = np.empty((horizon, env.dim, env.dim))
     S = env.initial_second_moment()
     for t in range(horizon):
         out[t] = S
-        S = F @ S @ F.T + noise
+        S = mm(mm(F, S), F.T) + noise
     return out
 
 
@@ -113,8 +115,9 @@ def expected_rewards(env: LQG, theta: np.ndarray | float, sigma: float | np.ndar
     K = env._gain(theta)
     S_pol = _check_sigma(sigma, env.dim)
     S = second_moments(env, K, sigma, horizon)
-    action_m2 = K @ S @ K.T + S_pol  # (H, m, m)
-    return -0.5 * (np.einsum("ij,tji->t", Q, S) + np.einsum("ij,tji->t", R, action_m2))
+    mm = portable.matmul
+    action_m2 = mm(mm(K, S), K.T) + S_pol  # (H, m, m)
+    return -0.5 * (portable.trace(mm(Q, S)) + portable.trace(mm(R, action_m2)))
 
 
 def finite_horizon_performance(
@@ -144,7 +147,7 @@ def finite_horizon_performance(
     """
     H = env.horizon if horizon is None else horizon
     r = expected_rewards(env, theta, sigma, H)
-    return float(r @ env.gamma ** np.arange(H))
+    return float(np.sum(r * portable.powers(env.gamma, H)))
 
 
 def finite_horizon_optimal_gain(
@@ -182,7 +185,7 @@ def horizon_matching_value(
         The horizon and its J_H.
     """
     r = expected_rewards(env, theta, sigma, max_horizon)
-    J = np.cumsum(r * env.gamma ** np.arange(max_horizon))
+    J = np.cumsum(r * portable.powers(env.gamma, max_horizon))
     h = int(np.argmin(np.abs(J - target)))
     return h + 1, float(J[h])
 

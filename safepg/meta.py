@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from safepg import portable
 from safepg.bounds import ErrorBound
 from safepg.constants import TaskConstants
 
@@ -57,7 +58,8 @@ def coordinate_step(g: float, eps: float, c: float) -> float:
     g = _check_g(g)
     if eps >= g:
         return 0.0
-    return (g - eps) ** 2 / (2 * c * (g + eps) ** 2)
+    lo, hi = g - eps, g + eps
+    return lo * lo / (2 * c * (hi * hi))
 
 
 def guaranteed_improvement(g: float, eps: float, c: float) -> float:
@@ -68,7 +70,8 @@ def guaranteed_improvement(g: float, eps: float, c: float) -> float:
     g = _check_g(g)
     if eps >= g:
         return 0.0
-    return (g - eps) ** 4 / (4 * c * (g + eps) ** 2)
+    lo, hi = g - eps, g + eps
+    return (lo * lo) * (lo * lo) / (4 * c * (hi * hi))
 
 
 def scalar_step(grad: np.ndarray, eps: float, c: float) -> float:
@@ -84,10 +87,10 @@ def scalar_step(grad: np.ndarray, eps: float, c: float) -> float:
     """
     a = np.abs(np.asarray(grad, dtype=float))
     lower = np.maximum(a - eps, 0.0)
-    upper = np.sum(a + eps)
+    upper = math.fsum((a + eps).tolist())  # exact sums, not BLAS (safepg.portable)
     if upper == 0:
         return 0.0
-    return float(lower @ lower / (2 * c * upper**2))
+    return float(portable.dot(lower, lower) / (2 * c * (upper * upper)))
 
 
 def upsilon(
@@ -104,7 +107,10 @@ def upsilon(
     """
     n_arr = np.asarray(n, dtype=float)
     eps = np.asarray(bound.eps(n_arr))
-    val = (g - eps) ** 4 / (4 * c * n_arr * (g + eps) ** 2)
+    # Products, not **: NumPy's power has CPU-specific SIMD versions (safepg.portable), and
+    # N* is where consecutive values of Upsilon differ in their last bits.
+    lo, hi = g - eps, g + eps
+    val = (lo * lo) * (lo * lo) / (4 * c * n_arr * (hi * hi))
     if saturate:
         val = np.where(eps < g, val, 0.0)
     return float(val) if val.ndim == 0 else val
@@ -121,7 +127,8 @@ def n_zero(g: float, bound: ErrorBound) -> float:
     if g == 0:
         return math.inf
     d, f = bound.d, bound.f
-    return ((d + math.sqrt(d * d + 4 * f * g)) / (2 * g)) ** 2
+    root = (d + math.sqrt(d * d + 4 * f * g)) / (2 * g)
+    return root * root
 
 
 def n_star_closed_form(g: float, bound: ErrorBound) -> int:
@@ -134,7 +141,7 @@ def n_star_closed_form(g: float, bound: ErrorBound) -> int:
     g = _check_g(g)
     if g == 0:
         return math.inf  # type: ignore[return-value]
-    return math.ceil(N_STAR_FACTOR * bound.d**2 / g**2)
+    return math.ceil(N_STAR_FACTOR * (bound.d * bound.d) / (g * g))
 
 
 def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = None) -> int:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from safepg import portable
 from safepg._rng import RNGLike, as_generator
 
 
@@ -56,8 +57,9 @@ class LinearGaussianPolicy:
             raise ValueError("theta must be finite (got NaN or inf in the gain)")
         self.gain = K
         self.cov = _check_sigma(sigma, K.shape[0])
-        self.cov_chol = np.linalg.cholesky(self.cov)
-        self.precision = np.linalg.inv(self.cov)
+        # Fixed-order factorisations (safepg.portable): LAPACK's last bit depends on the CPU.
+        self.cov_chol = portable.cholesky(self.cov)
+        self.precision = portable.solve(self.cov, np.eye(self.cov.shape[0]))
 
     @property
     def action_dim(self) -> int:
@@ -75,7 +77,10 @@ class LinearGaussianPolicy:
     @property
     def sigma(self) -> float:
         """Smallest action standard deviation (the sigma of the thesis's scalar bounds)."""
-        return float(np.sqrt(np.min(np.linalg.eigvalsh(self.cov))))
+        cov = self.cov
+        if np.count_nonzero(cov - np.diag(np.diag(cov))) == 0:  # read off exactly, not by LAPACK
+            return float(np.sqrt(np.min(np.diag(cov))))
+        return float(np.sqrt(np.min(np.linalg.eigvalsh(cov))))
 
     def with_theta(self, theta: np.ndarray) -> LinearGaussianPolicy:
         """The same policy with parameter vector ``theta``."""
@@ -92,13 +97,13 @@ class LinearGaussianPolicy:
 
     def mean(self, features: np.ndarray) -> np.ndarray:
         """K phi(s) for features of shape (..., d_phi) -> (..., d_a)."""
-        return features @ self.gain.T
+        return portable.matmul(features, self.gain.T)
 
     def sample(self, features: np.ndarray, rng: RNGLike = None) -> np.ndarray:
         """Draw a ~ N(K phi(s), Sigma) for each row of ``features``."""
         rng = as_generator(rng)
         noise = rng.standard_normal(features.shape[:-1] + (self.action_dim,))
-        return self.mean(features) + noise @ self.cov_chol.T
+        return self.mean(features) + portable.matmul(noise, self.cov_chol.T)
 
     def log_density(self, features: np.ndarray, actions: np.ndarray) -> np.ndarray:
         """log pi_theta(a | s), shape features.shape[:-1]."""
@@ -114,6 +119,6 @@ class LinearGaussianPolicy:
 
         flattened row-major to shape (..., m) with m = d_a * d_phi.
         """
-        diff = (actions - self.mean(features)) @ self.precision  # precision is symmetric
+        diff = portable.matmul(actions - self.mean(features), self.precision)  # precision is symmetric
         outer = diff[..., :, None] * features[..., None, :]
         return outer.reshape(features.shape[:-1] + (self.gain.size,))

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from safepg import portable
+
 
 @dataclass(frozen=True)
 class Trajectories:
@@ -46,8 +48,8 @@ class Trajectories:
 
     def discounts(self) -> np.ndarray:
         """gamma^t for t = 0, ..., H-1."""
-        return self.gamma ** np.arange(self.horizon)
+        return portable.powers(self.gamma, self.horizon)  # gamma * gamma * ..., as the kernels do
 
     def discounted_returns(self) -> np.ndarray:
         """Per-trajectory discounted return sum_t gamma^t r_t, shape (N,)."""
-        return self.rewards @ self.discounts()
+        return np.sum(self.rewards * self.discounts(), axis=1)  # not BLAS (safepg.portable)

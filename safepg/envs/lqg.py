@@ -20,8 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import solve_discrete_lyapunov
 
+from safepg import portable
 from safepg._rng import RNGLike, as_generator
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
@@ -35,6 +35,14 @@ def _as_matrix(x: float | np.ndarray, m: int, name: str) -> np.ndarray:
     if a.shape != (m, m):
         raise ValueError(f"{name} must be a scalar or a ({m}, {m}) matrix, got shape {a.shape}")
     return a
+
+
+def _largest_eigenvalue(M: np.ndarray) -> float:
+    """lambda_max of a symmetric cost matrix. A diagonal one (every task of the thesis) is
+    read off exactly; LAPACK, whose last bit can depend on the CPU, only for the others."""
+    if np.count_nonzero(M - np.diag(np.diag(M))) == 0:
+        return float(np.max(np.diag(M)))
+    return float(np.max(np.linalg.eigvalsh(M)))
 
 
 @dataclass(frozen=True)
@@ -100,8 +108,8 @@ class LQG:
     def reward_bound(self) -> float:
         """R = max |r| over the boxes: 0.5 (lambda_max(Q) m b_s^2 + lambda_max(R) m b_a^2)."""
         _, _, Q, R = self._mats
-        q = np.max(np.linalg.eigvalsh(Q)) * self.dim * self.state_bound**2
-        r = np.max(np.linalg.eigvalsh(R)) * self.dim * self.action_bound**2
+        q = _largest_eigenvalue(Q) * self.dim * self.state_bound**2
+        r = _largest_eigenvalue(R) * self.dim * self.action_bound**2
         return float(0.5 * (q + r))
 
     @property
@@ -128,18 +136,19 @@ class LQG:
         A, B, Q, R = self._mats
         m, H, bs, ba = self.dim, self.horizon, self.state_bound, self.action_bound
         s = rng.uniform(-bs, bs, size=(n, m))
-        raw = rng.standard_normal((n, H, m)) @ policy.cov_chol.T
+        mm = portable.matmul  # fixed-order products: the batch is the same on every CPU
+        raw = mm(rng.standard_normal((n, H, m)), policy.cov_chol.T)
         feats = np.empty((n, H, m))
         acts = np.empty((n, H, m))
         rews = np.empty((n, H))
         # Time is sequential; each step is one whole-array operation over the n trajectories.
         for t in range(H):
             feats[:, t] = s
-            raw[:, t] += s @ policy.gain.T
+            raw[:, t] += mm(s, policy.gain.T)
             u = np.clip(raw[:, t], -ba, ba) if self.clip else raw[:, t]
             acts[:, t] = u
-            rews[:, t] = -0.5 * (np.einsum("ni,ij,nj->n", s, Q, s) + np.einsum("ni,ij,nj->n", u, R, u))
-            s = s @ A.T + u @ B.T
+            rews[:, t] = -0.5 * (np.sum(mm(s, Q) * s, axis=1) + np.sum(mm(u, R) * u, axis=1))
+            s = mm(s, A.T) + mm(u, B.T)
             if self.clip:
                 s = np.clip(s, -bs, bs)
         return Trajectories(feats, raw, acts, rews, None, self.gamma)
@@ -165,10 +174,39 @@ class LQG:
 
     def is_stable(self, theta: np.ndarray | float) -> bool:
         """Whether sqrt(gamma) (A + B K) is a contraction, so J(theta) is finite."""
+        return bool(self._stable(self._gain(theta)[None])[0])
+
+    def _stable(self, K: np.ndarray) -> np.ndarray:
+        """:meth:`is_stable` for a batch of gains K, shape (I, m, m) -> (I,) bool."""
         A, B, _, _ = self._mats
-        F = A + B @ self._gain(theta)
-        radius = abs(F[0, 0]) if self.dim == 1 else np.max(np.abs(np.linalg.eigvals(F)))
-        return bool(radius * np.sqrt(self.gamma) < 1)
+        F = A + portable.matmul(B, K)
+        if self.dim == 1:
+            radius = np.abs(F[:, 0, 0])
+        else:
+            # LAPACK's eigenvalues may differ across CPUs in the last bit; only the yes/no
+            # answer is used, and it could flip only for a gain exactly on the boundary.
+            radius = np.max(np.abs(np.linalg.eigvals(F)), axis=1)
+        return radius * np.sqrt(self.gamma) < 1
+
+    def _lyapunov(self, F: np.ndarray, M: np.ndarray) -> np.ndarray:
+        r"""P solving :math:`P = M + \gamma F^\top P F` for a batch (I, m, m) of F and M.
+
+        Solved as the linear system :math:`(I - \gamma F^\top\otimes F^\top)\,\mathrm{vec}(P)
+        = \mathrm{vec}(M)` by :func:`safepg.portable.solve`, so J comes out bit-identical on
+        every CPU (scipy's and NumPy's solvers go through BLAS; see :mod:`safepg.portable`).
+        """
+        d = self.dim
+        Ft = np.swapaxes(F, 1, 2)
+        kron = (Ft[:, :, None, :, None] * Ft[:, None, :, None, :]).reshape(-1, d * d, d * d)
+        P = portable.solve(np.eye(d * d) - self.gamma * kron, M.reshape(-1, d * d, 1)).reshape(-1, d, d)
+        return 0.5 * (P + np.swapaxes(P, 1, 2))
+
+    def _value_matrices(self, K: np.ndarray) -> np.ndarray:
+        """:meth:`value_matrix` for a batch of stable gains K, shape (I, m, m)."""
+        A, B, Q, R = self._mats
+        F = A + portable.matmul(B, K)
+        M = 0.5 * (Q + portable.matmul(portable.matmul(np.swapaxes(K, 1, 2), R), K))
+        return self._lyapunov(F, M)
 
     def value_matrix(self, theta: np.ndarray | float) -> np.ndarray:
         r"""P solving the discounted Lyapunov equation
@@ -177,16 +215,10 @@ class LQG:
 
         so that V(s) = -s^T P s - v_0 for the unclipped infinite-horizon problem.
         """
-        A, B, Q, R = self._mats
         K = self._gain(theta)
         if not self.is_stable(K):
             raise ValueError("theta makes the closed loop unstable: J(theta) = -inf")
-        F = A + B @ K
-        M = 0.5 * (Q + K.T @ R @ K)
-        if self.dim == 1:  # the learning loop evaluates J every iteration: skip the solver
-            return M / (1 - self.gamma * F * F)
-        P = solve_discrete_lyapunov(np.sqrt(self.gamma) * F.T, M)
-        return 0.5 * (P + P.T)
+        return self._value_matrices(K[None])[0]
 
     def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
         r"""Closed-form expected performance J(theta) (infinite horizon, no clipping).
@@ -201,13 +233,7 @@ class LQG:
         P = 0.5 (1 + theta^2) / (1 - gamma (1 + theta)^2). Returns -inf if unstable.
         """
         K = self._gain(theta)
-        if not self.is_stable(K):
-            return -np.inf
-        _, B, _, R = self._mats
-        S = _check_sigma(sigma, self.dim)
-        P = self.value_matrix(K)
-        noise = 0.5 * np.trace(R @ S) + self.gamma * np.trace(B.T @ P @ B @ S)
-        return float(-np.trace(P @ self.initial_second_moment()) - noise / (1 - self.gamma))
+        return float(self.performance_batch(K.reshape(1, -1), sigma)[0])
 
     def performance_batch(self, thetas: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
         r""":meth:`performance` for many parameters at once, shape (I,).
@@ -230,20 +256,16 @@ class LQG:
             raise ValueError(f"thetas must have shape (I, {d * d}), got {T.shape}")
         if not np.all(np.isfinite(T)):
             raise ValueError("thetas must be finite")
-        A, B, Q, R = self._mats
+        _, B, _, R = self._mats
         S = _check_sigma(sigma, d)
         K = T.reshape(-1, d, d)
-        F = A + B @ K
-        radius = np.abs(F[:, 0, 0]) if d == 1 else np.max(np.abs(np.linalg.eigvals(F)), axis=1)
-        stable = radius * np.sqrt(self.gamma) < 1
-        F = np.where(stable[:, None, None], F, 0.0)  # keeps the solve regular; the rows are -inf below
-        with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's gains; their rows are -inf
-            M = np.where(stable[:, None, None], 0.5 * (Q + np.swapaxes(K, 1, 2) @ R @ K), 0.0)
-        Ft = np.swapaxes(F, 1, 2)
-        kron = np.einsum("iab,icd->iacbd", Ft, Ft).reshape(-1, d * d, d * d)
-        P = np.linalg.solve(np.eye(d * d) - self.gamma * kron, M.reshape(-1, d * d, 1)).reshape(-1, d, d)
-        noise = 0.5 * np.trace(R @ S) + self.gamma * np.einsum("ab,iac,cb->i", B, P, B @ S)
-        J = -np.einsum("iab,ba->i", P, self.initial_second_moment()) - noise / (1 - self.gamma)
+        stable = self._stable(K)
+        # Unstable rows get K = 0 (a regular system); they are -inf below.
+        K = np.where(stable[:, None, None], K, 0.0)
+        P = self._value_matrices(K)
+        mm = portable.matmul
+        noise = 0.5 * portable.trace(mm(R, S)) + self.gamma * portable.trace(mm(mm(mm(B.T, P), B), S))
+        J = -portable.trace(mm(P, self.initial_second_moment())) - noise / (1 - self.gamma)
         return np.where(stable, J, -np.inf)
 
     def gradient(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> np.ndarray:
@@ -257,13 +279,14 @@ class LQG:
         with :math:`W = \mathbb E[s_0 s_0^\top] + \gamma B\Sigma B^\top/(1-\gamma)`.
         """
         A, B, _, R = self._mats
+        mm = portable.matmul
         K = self._gain(theta)
         S = _check_sigma(sigma, self.dim)
         P = self.value_matrix(K)
-        F = A + B @ K
-        W = self.initial_second_moment() + self.gamma * B @ S @ B.T / (1 - self.gamma)
-        Y = solve_discrete_lyapunov(np.sqrt(self.gamma) * F, W)
-        return (-(R @ K + 2 * self.gamma * B.T @ P @ F) @ Y).ravel()
+        F = A + mm(B, K)
+        W = self.initial_second_moment() + self.gamma * mm(mm(B, S), B.T) / (1 - self.gamma)
+        Y = self._lyapunov(F.T[None], W[None])[0]  # Y = W + gamma F Y F^T
+        return (-mm(mm(R, K) + 2 * self.gamma * mm(mm(B.T, P), F), Y)).ravel()
 
     def optimal_gain(self, tol: float = 1e-14, max_iter: int = 100_000) -> np.ndarray:
         r"""Optimal gain K* (the thesis's theta*) by Riccati value iteration.
@@ -276,16 +299,19 @@ class LQG:
         The policy noise adds a constant to J, so K* does not depend on Sigma.
         """
         A, B, Q, R = self._mats
-        g = self.gamma
+        mm, g = portable.matmul, self.gamma
+
+        def gain(P: np.ndarray) -> np.ndarray:
+            return portable.solve(0.5 * R + g * mm(mm(B.T, P), B), g * mm(mm(B.T, P), A))
+
         P = 0.5 * Q
         for _ in range(max_iter):
-            G = np.linalg.solve(0.5 * R + g * B.T @ P @ B, g * B.T @ P @ A)
-            P_new = 0.5 * Q + g * A.T @ P @ A - g * A.T @ P @ B @ G
+            P_new = 0.5 * Q + g * mm(mm(A.T, P), A) - g * mm(mm(mm(A.T, P), B), gain(P))
             if np.max(np.abs(P_new - P)) < tol * max(1.0, np.max(np.abs(P))):
                 P = P_new
                 break
             P = P_new
-        return -np.linalg.solve(0.5 * R + g * B.T @ P @ B, g * B.T @ P @ A)
+        return -gain(P)
 
     # ------------------------------------------------------------------ fast path
     def gradient_batch(

@@ -1,0 +1,65 @@
+"""Short learning runs whose every output bit is printed as a digest (run by test_portable.py).
+
+``python tests/portable_probe.py`` prints one JSON object: for each run, a SHA-256 of every
+array of its record and the report quantities (Upsilon-bar, improvement ratio, J at the
+checkpoints, the seed-mean interval) as float hex strings. The test runs it in subprocesses
+under different CPU settings and compares the outputs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+
+from safepg.envs.cartpole import CartPole
+from safepg.envs.lqg import LQG
+from safepg.experiments import mean_ci95
+from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+
+
+def digest(rec: LearningRecord) -> dict[str, object]:
+    h = hashlib.sha256()
+    for name in ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe"):
+        h.update(np.ascontiguousarray(getattr(rec, name)).tobytes())
+    return {"arrays": h.hexdigest(), "upsilon_bar": float.hex(rec.upsilon_bar()),
+            "improvement_ratio": float.hex(rec.improvement_ratio()),
+            "J_at": {k: float.hex(v) for k, v in rec.J_at((10_000, 50_000)).items()}}
+
+
+def runs() -> dict[str, list[LearningRecord]]:
+    lqg1, lqg2 = LQG.thesis_1d(), LQG.thesis_2d(gamma=0.9)
+    return {
+        "1d-bernstein-er": [adaptive_pg(lqg1, bound="bernstein", empirical_range=True, budget=60_000, rng=s)
+                            for s in range(3)],
+        "1d-chebyshev-reinforce": [adaptive_pg(lqg1, estimator="reinforce", budget=60_000, rng=s) for s in range(3)],
+        "1d-hoeffding": [adaptive_pg(lqg1, bound="hoeffding", budget=30_000, rng=0)],
+        "1d-vanilla-raw": [vanilla_pg(lqg1, -0.55, 0.5, batch_size=100, alpha=1e-3, score_action="raw",
+                                      budget=20_000, rng=0)],
+        "2d-scalar-step": [vanilla_pg(lqg2, np.zeros(4), batch_size=500, alpha=None, step="scalar",
+                                      budget=20_000, rng=0)],
+        "2d-bernstein": [adaptive_pg(lqg2, np.zeros(4), bound="bernstein", empirical_range=True,
+                                     budget=30_000, rng=0)],
+        "cartpole-vanilla": [vanilla_pg(CartPole.thesis(), np.zeros(4), batch_size=200, alpha=0.01,
+                                        budget=2_000, rng=0)],
+        "cartpole-adaptive": [adaptive_pg(CartPole.thesis_doubled(), np.array([0.5, 1.0, 20.0, 3.0]),
+                                          bound="bernstein", empirical_range=True, budget=2_000, rng=0)],
+    }
+
+
+def main() -> None:
+    out: dict[str, object] = {}
+    for name, recs in runs().items():
+        out[name] = [digest(r) for r in recs]
+        ci = mean_ci95(r.upsilon_bar() for r in recs)
+        out[name + ":ci95"] = [float.hex(v) for v in ci["ci95"]] if len(recs) > 1 else None
+    lqg2 = LQG.thesis_2d(gamma=0.9)
+    out["closed-forms"] = [float.hex(float(v)) for v in (
+        *lqg2.optimal_gain().ravel(), lqg2.performance(np.diag([-0.3, -0.5]), 1.0),
+        *lqg2.gradient(np.array([[-0.3, 0.05], [0.02, -0.5]]), 1.0))]
+    print(json.dumps(out, sort_keys=True))
+
+
+if __name__ == "__main__":
+    main()
