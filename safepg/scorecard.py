@@ -43,6 +43,7 @@ from safepg.envs.lqg import LQG
 from safepg.experiments import (
     EXPERIMENTS,
     LQG2D_GAMMA,
+    T51_PRINTED_THETA0,
     Experiment,
     get_experiment,
     load_experiment,
@@ -65,8 +66,6 @@ GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5
 PRINTED: dict[str, Any] = {
     # Section 5.1: "theta* ~ -0.59, corresponding to expected performance J(theta*) ~ -13.21".
     "lqg1d_theta_star": "-0.59",
-    # Section 5.1, Table 5.1: "starting from theta = -0.55".
-    "table_5_1_theta0": "-0.55",
     "lqg1d_J_star": "-13.21",
     # Section 5.1: "step sizes ... of the order of 10^-5" (also "In all the experiments").
     "lqg1d_step_order": -5,
@@ -425,10 +424,14 @@ class _Builder:
 
     def add(self, *, id: str, group: str, quantity: str, where: str, thesis: str, ours: str, difference: str,
             ok: bool | None, rule: str, page: str, heading: str, note_id: str | None = None,
-            explanation: str | None = None, **extra: Any) -> None:
-        """``ok=None``: nothing to compare (missing runs): open."""
+            explanation: str | None = None, expected_seeds: int | None = None, **extra: Any) -> None:
+        """Append a row. ``ok=None``: nothing to compare (missing runs): open. A row measured on
+        fewer seeds than ``expected_seeds`` is not judged either (a partly computed campaign)."""
         if rule not in RULES:
             raise ValueError(f"rule must be one of {sorted(RULES)}, got {rule!r}")
+        seeds = extra.get("seeds")
+        if expected_seeds is not None and seeds is not None and 0 < seeds < expected_seeds:
+            ok, explanation = None, f"Not judged: only {seeds} of {expected_seeds} seeds are in the results store."
         note = self.note(note_id or id)
         if ok:
             status: Status = "reproduced"
@@ -564,7 +567,7 @@ def _table_5_1_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any], varian
     others = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
         others[(vc.sigma, vc.batch_size, vc.alpha)] = (vc, vr)
-    printed_theta0 = PRINTED["table_5_1_theta0"]
+    printed_theta0 = repr(T51_PRINTED_THETA0)
     for c, r in zip(exp.configs, rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
         if thesis is None:
@@ -586,7 +589,7 @@ def _table_5_1_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any], varian
               ours=_pct(mean) + _ci_text(ci, lambda x: _pct(x, 1)),
               difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
               rule="ratio-points", page="lqg1d", heading="Table 5.1", explanation=explanation, thesis_value=thesis,
-              ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
+              ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=exp.seeds,
               fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": theta0})
 
 
@@ -636,11 +639,12 @@ def _table_5_2_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
               difference="-" if mean is None else _signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
               page="lqg1d", heading="Table 5.2", note_id=note_id, explanation=explanation,
               thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-              fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
+              expected_seeds=exp.seeds, fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
                       "delta": c.delta, "theoretical_range": c.theoretical_range,
                       "thesis_ci95": list(th["ci95"])})
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
-    got = [x for x in ratios if x is not None]
+    complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
+    got = [x for x in ratios if x is not None] if complete else []
     low = min(got) if got else None
     b.add(id="section-5.1/improvement-ratio-adaptive", group="Section 5.1",
           quantity="improvement ratio of Algorithm 4.1, every Table 5.2 configuration (lowest)",
@@ -651,8 +655,10 @@ def _table_5_2_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
 
 
 def _step_rows(b: _Builder, *, rid: str, group: str, where: str, quantity: str, recs: Mapping[str, Sequence],
-               names: Iterable[str], k: int, page: str, heading: str) -> None:
+               names: Iterable[str], k: int, page: str, heading: str, seeds: int) -> None:
     medians, names = [], list(names)
+    if any(len(recs.get(n, [])) < seeds for n in names):  # judged on the whole campaign only
+        names = names + ["(missing seeds)"]
     for n in names:
         steps = np.concatenate([r.alpha[r.alpha > 0] for r in recs.get(n, [])] or [np.empty(0)])
         if steps.size:
@@ -717,7 +723,7 @@ def _figures_5_5_5_6_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
                   ok=None if mean is None else within_points(mean, th["improvement_ratio"]), rule="ratio-points",
                   page="lqg2d", heading="Figures 5.5 and 5.6", thesis_value=th["improvement_ratio"],
-                  ours_value=mean, ours_ci95=ci, seeds=r["seeds"])
+                  ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=exp.seeds)
         if "theta_final" in th:
             printed = np.asarray(th["theta_final"], dtype=float)
             finals = np.array([rec.theta_final.reshape(printed.shape) for rec in recs.get(c.name, [])])
@@ -734,7 +740,8 @@ def _figures_5_5_5_6_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
                       difference="-" if mean is None else f"{mean - p:+.2g}",
                       ok=None if mean is None else in_seed_range(list(seeds), text), rule="seed-range",
                       page="lqg2d", heading="Figures 5.5 and 5.6", thesis_value=float(p), ours_value=mean,
-                      seeds=int(seeds.size), fields={"step": c.name, "entry": f"{i + 1}{j + 1}"})
+                      seeds=int(seeds.size), expected_seeds=exp.seeds,
+                      fields={"step": c.name, "entry": f"{i + 1}{j + 1}"})
 
 
 def _upsilon_table_rows(b: _Builder, table: str, exp: Experiment, rep: Mapping[str, Any], page: str,
@@ -752,7 +759,7 @@ def _upsilon_table_rows(b: _Builder, table: str, exp: Experiment, rep: Mapping[s
                   difference="-" if mean is None else _signed(mean - th["upsilon_bar"], dec),
                   ok=None if mean is None else in_widened_interval(text, ci), rule="ci-contains", page=page,
                   heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-                  fields={"method": c.name, "quantity": "upsilon_bar"})
+                  expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"})
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             b.add(id=f"{table}/{c.name}/improvement-ratio", group=group, quantity=f"improvement ratio, {method}",
@@ -761,10 +768,10 @@ def _upsilon_table_rows(b: _Builder, table: str, exp: Experiment, rep: Mapping[s
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
                   ok=None if mean is None else within_points(mean, th["improvement_ratio"]), rule="ratio-points",
                   page=page, heading=heading, thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci,
-                  seeds=r["seeds"], fields={"method": c.name, "quantity": "improvement_ratio"})
+                  seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "improvement_ratio"})
 
 
-def _table_5_3_extra_rows(b: _Builder, recs: Mapping[str, Sequence[LearningRecord]]) -> None:
+def _table_5_3_extra_rows(b: _Builder, recs: Mapping[str, Sequence[LearningRecord]], seeds: int) -> None:
     adaptive = recs.get("adaptive", [])
     # As the chapter measures them: mean batch over iterations 2-11, and over the last 10 full ones.
     first = [float(r.batch_size[1:11].mean()) for r in adaptive if r.iterations > 11]
@@ -781,10 +788,11 @@ def _table_5_3_extra_rows(b: _Builder, recs: Mapping[str, Sequence[LearningRecor
               ours="-" if mean is None else f"{mean:.0f} (seeds {min(vals):.0f} to {max(vals):.0f})",
               difference="-" if mean is None else f"{mean - float(printed):+.0f}",
               ok=None if mean is None else in_seed_range(vals, printed), rule="seed-range", page="lqg2d",
-              heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals))
+              heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
+              expected_seeds=seeds)
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
-               k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3")
+               k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds)
 
 
 def _cartpole_rows(b: _Builder, base_exp: Experiment, base_recs: Mapping[str, Sequence[LearningRecord]],
@@ -802,7 +810,8 @@ def _cartpole_rows(b: _Builder, base_exp: Experiment, base_recs: Mapping[str, Se
               ours="-" if mean is None else f"{mean:.1f} (seeds {min(its):.0f} to {max(its):.0f})",
               difference="-" if mean is None else f"{mean - th['iterations']:+.1f}",
               ok=None if mean is None else in_seed_range(its, text), rule="seed-range", page="cartpole",
-              heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean, seeds=len(its))
+              heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean, seeds=len(its),
+              expected_seeds=base_exp.seeds)
     adaptive = recs54.get("adaptive", [])
     steps = np.concatenate([r.alpha[r.alpha > 0] for r in adaptive] or [np.empty(0)])
     b.values["adaptive_steps"] = f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none"
@@ -810,7 +819,7 @@ def _cartpole_rows(b: _Builder, base_exp: Experiment, base_recs: Mapping[str, Se
     never = PRINTED["cartpole_components_never_updated"]
     updated = None
     for r in rep54["configs"]:
-        if r["name"] == "adaptive" and r["seeds"]:
+        if r["name"] == "adaptive" and r["seeds"] == exp54.seeds:  # the whole campaign only
             updated = r["components_updated"]
     if updated is not None:
         extra = [i for i in updated if i in never]
@@ -886,10 +895,10 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
                names=[c.name for c in exps["table-5.2"].configs], k=PRINTED["lqg1d_step_order"], page="lqg1d",
-               heading="Figures 5.3 and 5.4")
+               heading="Figures 5.3 and 5.4", seeds=exps["table-5.2"].seeds)
     _figures_5_5_5_6_rows(b, exps["figures-5.5-5.6"], reps["figures-5.5-5.6"], recs["figures-5.5-5.6"])
     _upsilon_table_rows(b, "table-5.3", exps["table-5.3"], reps["table-5.3"], "lqg2d", "Table 5.3", "Section 5.2")
-    _table_5_3_extra_rows(b, recs["table-5.3"])
+    _table_5_3_extra_rows(b, recs["table-5.3"], exps["table-5.3"].seeds)
     _cartpole_rows(b, exps["cartpole-baseline"], recs["cartpole-baseline"], exps["table-5.4"], reps["table-5.4"],
                    recs["table-5.4"])
     order = {g: i for i, g in enumerate(GROUPS)}
