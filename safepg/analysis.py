@@ -157,7 +157,7 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[tuple[str, 
         text = format(v, spec) if spec else str(v)
         return text.replace("|", "\\|")  # a bare | would end the cell
 
-    head = "| " + " | ".join(h for _, h, _ in columns) + " |"
+    head = "| " + " | ".join(h.replace("|", "\\|") for _, h, _ in columns) + " |"  # "mean |diff|" too
     sep = "|" + "|".join("---" for _ in columns) + "|"
     body = ["| " + " | ".join(fmt(r.get(k), s) for k, _, s in columns) + " |" for r in rows]
     table = "\n".join([head, sep, *body])

@@ -62,7 +62,10 @@ AUDIT_JS = r"""() => {
   const shown = e => (e.checkVisibility ? e.checkVisibility({checkVisibilityCSS: true}) : !!e.offsetParent)
                      && e.getBoundingClientRect().width > 0;
   const ox = e => getComputedStyle(e).overflowX;
-  const skip = e => e.closest('mjx-assistive-mml, .visually-hidden, .sr-only, [hidden], .headerlink');
+  // MathJax's internals (stretchy glyphs clip on purpose) and its hidden copy for screen
+  // readers are not what a reader sees: a formula is judged by its mjx-container.
+  const skip = e => e.closest('mjx-assistive-mml, .visually-hidden, .sr-only, [hidden], .headerlink')
+                    || (e.tagName !== 'MJX-CONTAINER' && e.closest('mjx-container'));
   const outside = r => r.right > A.right + 1 || r.left < A.left - 1;
   const describe = e => (e.tagName.toLowerCase() + (e.className && typeof e.className === 'string'
                           ? '.' + e.className.trim().split(/\s+/).slice(0, 2).join('.') : '')
@@ -107,7 +110,7 @@ AUDIT_JS = r"""() => {
     code.push({source: input.textContent, lines: lines.length, wide, clippedLines: wraps || cued ? 0 : wide});
   }
   const captions = [...art.querySelectorAll('figure .caption-number, table caption .caption-number, '
-                                            + 'div.figure .caption-number')]
+                                            + 'div.figure .caption-number, .safepg-caption .caption-number')]
     .filter(e => shown(e)).map(e => e.textContent.trim().replace(/[\s:.]+$/, ''));
   const de = document.documentElement;
   return {pageOverflow: Math.max(0, de.scrollWidth - de.clientWidth), column: [Math.round(A.left), Math.round(A.right)],

@@ -39,6 +39,12 @@ def test_markdown_table_plain_and_captioned():
     assert captioned._repr_markdown_() == str(captioned)
 
 
+def test_markdown_table_escapes_pipes_in_headers_and_cells():
+    md = markdown_table([{"a": "x|y"}], [("a", "mean |diff|", "")])
+    assert md.splitlines()[0] == "| mean \\|diff\\| |"
+    assert md.splitlines()[2] == "| x\\|y |"
+
+
 def test_markdown_table_refuses_a_name_without_caption():
     with pytest.raises(ValueError, match="^name"):
         markdown_table([{"a": 1}], [("a", "a", "")], name="table-5-1")

@@ -19,6 +19,13 @@
   function mark() {
     const article = document.querySelector("article.bd-article") || document.querySelector("main");
     if (!article) return;
+    // An inline formula wider than the column (its typeset box wider than the span the theme
+    // caps at the column's width) gets a box of its own that can scroll.
+    for (const m of article.querySelectorAll("span.math")) {
+      const c = m.querySelector("mjx-container");
+      if (c && !m.classList.contains("safepg-wide-math") && c.getBoundingClientRect().width > m.clientWidth + 2)
+        m.classList.add("safepg-wide-math");
+    }
     for (const el of article.querySelectorAll("*")) {
       if (el.classList.contains(HINT)) continue;
       const scrolls = scrollsSideways(el);
@@ -44,9 +51,23 @@
     }
   }
 
+  function liftCaptions() {
+    // A table's caption is part of the table, so in a table that scrolls sideways the
+    // caption scrolls away with it and is cut off: show it above the scrolling box instead.
+    for (const cap of document.querySelectorAll(".pst-scrollable-table-container > table > caption")) {
+      const box = cap.closest(".pst-scrollable-table-container");
+      const div = document.createElement("div");
+      div.className = "safepg-caption " + cap.className;
+      while (cap.firstChild) div.appendChild(cap.firstChild);
+      cap.remove();
+      box.parentElement.insertBefore(div, box);
+    }
+  }
+
   let timer = null;
   function later() { clearTimeout(timer); timer = setTimeout(mark, 150); }
   window.addEventListener("load", () => {
+    liftCaptions();
     mark();
     if (window.MathJax && MathJax.startup && MathJax.startup.promise) MathJax.startup.promise.then(mark);
   });
