@@ -404,8 +404,8 @@ def lab_value_matrix(theta: np.ndarray, weight: float, gamma: float) -> np.ndarr
         raise ValueError(f"gamma must be in (0, 1), got {gamma}")
     if not weight > 0:
         raise ValueError(f"weight must be > 0, got {weight}")
-    eye = np.eye(m)
-    return (weight * eye + weight * K.T @ K) @ np.linalg.inv(eye - gamma * (eye + 2 * K + K * K))
+    eye, mm = np.eye(m), portable.matmul  # fixed order: these values are printed (safepg.portable)
+    return mm(weight * eye + weight * mm(K.T, K), portable.solve(eye - gamma * (eye + 2 * K + K * K), eye))
 
 
 def lab_performance_moments(theta: np.ndarray, noise_cov: float | np.ndarray, weight: float, gamma: float,
@@ -443,7 +443,7 @@ def lab_performance_moments(theta: np.ndarray, noise_cov: float | np.ndarray, we
     P = lab_value_matrix(theta, weight, gamma)
     m = P.shape[0]
     S = np.eye(m) * noise_cov if np.ndim(noise_cov) == 0 else np.asarray(noise_cov, dtype=float)
-    W = float(np.trace(S @ (weight * np.eye(m) + gamma * P))) / (1 - gamma)
+    W = float(portable.trace(portable.matmul(S, weight * np.eye(m) + gamma * P))) / (1 - gamma)
     b2 = state_bound**2
     mean = -float(np.trace(P)) * b2 / 3 - W
     off = P + P.T
@@ -457,9 +457,9 @@ def lab_performance_at_states(theta: np.ndarray, noise_cov: float | np.ndarray, 
     P = lab_value_matrix(theta, weight, gamma)
     m = P.shape[0]
     S = np.eye(m) * noise_cov if np.ndim(noise_cov) == 0 else np.asarray(noise_cov, dtype=float)
-    W = float(np.trace(S @ (weight * np.eye(m) + gamma * P))) / (1 - gamma)
+    W = float(portable.trace(portable.matmul(S, weight * np.eye(m) + gamma * P))) / (1 - gamma)
     x = np.asarray(states, dtype=float)
-    return float(-np.mean(np.einsum("ni,ij,nj->n", x, P, x)) - W)
+    return float(-np.mean(np.sum(portable.matmul(x, P) * x, axis=1)) - W)
 
 
 def lab_readings(
