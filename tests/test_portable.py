@@ -242,7 +242,8 @@ def _calls(module: str) -> list[tuple[str, str, int]]:
             elif (isinstance(child, ast.Attribute) and child.attr in ("dot", "matmul", "tensordot", "inner", "vdot")
                   and getattr(child.value, "id", "") in ("np", "numpy")):
                 what = "np." + child.attr
-            elif isinstance(child, ast.Attribute) and child.attr == "stats" and getattr(child.value, "id", "") == "scipy":
+            elif (isinstance(child, ast.Attribute) and child.attr == "stats"
+                  and getattr(child.value, "id", "") == "scipy"):
                 what = "scipy.stats"
             elif isinstance(child, ast.ImportFrom) and child.module in ("scipy.linalg", "scipy.stats", "numpy.linalg"):
                 what = child.module
