@@ -96,14 +96,17 @@ function safepgTicks(lo, hi, log) {
 }
 //: Width of one tick-label character at font-size 11, in SVG units (an upper estimate).
 const SAFEPG_CHAR_WIDTH = 6.5;
-function safepgTickLabels(ticks) {
+function safepgTickLabels(ticks, log) {
   // The shortest labels that still tell every tick apart: "1.5e7" next to "2e7" (never two
-  // "2e+7"), "1500" next to "1000". Exponent form below 1e-3 and from 1e5 on.
+  // "2e+7"), "1500" next to "1000". Exponent form below 1e-3 and from 1e5 on; on a linear
+  // axis reaching 1e5 every label takes it ("5e4", "1e5", "1.5e5", not "50000", "1e5").
+  const top = Math.max(...ticks.map(Math.abs));
+  const axisExp = !log && (top >= 1e5 || (top > 0 && top < 1e-3));
   for (let digits = 0; digits <= 12; digits++) {
     const labels = ticks.map(v => {
       const a = Math.abs(v);
       if (v === 0) return "0";
-      if (a >= 1e5 || a < 1e-3) {
+      if (axisExp || a >= 1e5 || a < 1e-3) {
         const [mant, exp] = v.toExponential(digits).split("e");
         return `${+mant}e${+exp}`;
       }
@@ -148,7 +151,7 @@ function safepgPlot(svg, spec, res) {
     return e;
   };
   const ink = {fill: "currentColor"}, thin = {stroke: "currentColor", "stroke-opacity": 0.12};
-  const xt = safepgTicks(x0, x1, spec.xlog), xl = safepgTickLabels(xt);
+  const xt = safepgTicks(x0, x1, spec.xlog), xl = safepgTickLabels(xt, spec.xlog);
   xt.forEach((xv, i) => {
     el("line", {x1: X(xv), x2: X(xv), y1: m.t, y2: Hh - m.b, ...thin});
     // A label at either end is anchored inside the plot instead of centred across its edge.
@@ -157,7 +160,7 @@ function safepgPlot(svg, spec, res) {
     const x = anchor === "end" ? W - 1 : anchor === "start" ? 1 : X(xv);
     el("text", {x, y: Hh - m.b + 16, "text-anchor": anchor, "font-size": 11, ...ink, class: "safepg-tick"}, xl[i]);
   });
-  const yt = safepgTicks(y0, y1, spec.ylog), yl = safepgTickLabels(yt);
+  const yt = safepgTicks(y0, y1, spec.ylog), yl = safepgTickLabels(yt, spec.ylog);
   yt.forEach((yv, i) => {
     el("line", {x1: m.l, x2: W - m.r, y1: Y(yv), y2: Y(yv), ...thin});
     el("text", {x: m.l - 6, y: Y(yv) + 4, "text-anchor": "end", "font-size": 11, ...ink, class: "safepg-tick"}, yl[i]);

@@ -21,7 +21,7 @@ pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 def axis(lo: float, hi: float, log: bool) -> tuple[list[float], list[str]]:
     """Tick values and labels of an axis from lo to hi (for a log axis, lo and hi are log10)."""
     script = (_RUNTIME_JS + f"\nconst t = safepgTicks({lo}, {hi}, {str(log).lower()});"
-              "\nconsole.log(JSON.stringify([t, safepgTickLabels(t)]));")
+              f"\nconsole.log(JSON.stringify([t, safepgTickLabels(t, {str(log).lower()})]));")
     out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
     ticks, labels = json.loads(out)
     return ticks, labels
@@ -50,4 +50,10 @@ def test_trajectory_axis_labels():
 
 def test_shortest_labels():
     assert axis(0, 1.2, False)[1] == ["0", "0.2", "0.4", "0.6", "0.8", "1", "1.2"]
-    assert axis(3, 5, True)[1][:3] == ["1000", "2000", "5000"]
+    assert axis(3, 5, True)[1][:3] == ["1000", "2000", "5000"]  # a log axis: each label on its own
+
+
+def test_one_style_per_linear_axis():
+    """A linear axis reaching 1e5 writes every label in exponent form (not "50000" beside "1e5")."""
+    assert axis(0, 3e5, False)[1] == ["0", "5e4", "1e5", "1.5e5", "2e5", "2.5e5", "3e5"]
+    assert axis(0, 5e4, False)[1][-1] == "50000"
