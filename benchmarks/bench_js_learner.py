@@ -8,9 +8,14 @@ Measures, on one core:
 - a run: Algorithm 4.1 for 10^6 trajectories (the explorer's default settings: G(PO)MDP,
   Bernstein with the empirical range, delta = 0.95, sigma = 1), both implementations.
 
-Both wall time and process CPU time are recorded (the build machine is shared: CPU time
-is the steadier figure). Results go to ``benchmarks/js_learner_timings.json``; the
-browser's own time for the same run is measured by ``tests/test_browser_learner.py``.
+- the same run in headless Chromium (Debian's, through Playwright): the explorer page of
+  ``safepg.live_learner`` with vanilla PG off, time inside the Web Worker's learner and
+  the page's time from the control move to the last curve (worker start, messages and
+  drawing included), for a few seeds.
+
+Both wall time and process CPU time are recorded where they can be (the build machine is
+shared: CPU time is the steadier figure; the browser gives wall time only). Results go to
+``benchmarks/js_learner_timings.json``.
 
 Usage: ``python benchmarks/bench_js_learner.py [--repeat 5]``
 """
@@ -67,6 +72,39 @@ def best_of(f, repeat: int) -> dict[str, float]:
     return {"wall_ms": 1e3 * wall, "cpu_ms": 1e3 * cpu}
 
 
+def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
+    """Wall times (s) of the explorer's 10^6-trajectory adaptive run in headless Chromium."""
+    chromium = shutil.which("chromium") or "/usr/bin/chromium"
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        return None
+    if not Path(chromium).exists():
+        return None
+    from safepg.live_learner import live_batch_size_explorer
+
+    out: dict[str, list[float]] = {"worker_s": [], "page_s": []}
+    with tempfile.TemporaryDirectory() as tmp, sync_playwright() as p:
+        page_path = Path(tmp) / "live.html"
+        page_path.write_text(f"<!doctype html><html><body>{live_batch_size_explorer().to_html()}</body></html>")
+        browser = p.chromium.launch(executable_path=chromium, args=["--headless", "--no-sandbox", "--disable-gpu"])
+        page = browser.new_page()
+        page.goto(page_path.as_uri())
+        done = """job => { const v = JSON.parse(document.querySelector('.safepg-values').textContent);
+                           return v.job === job && v.result.values.done; }"""
+        page.locator('[data-param="vanilla_n"]').select_option("off")  # job 2
+        page.wait_for_function(done, arg=2, timeout=120_000)
+        for k in range(seeds):
+            page.locator('[data-param="seed"]').fill(str(k + 1))
+            page.wait_for_function(done, arg=3 + k, timeout=120_000)
+            v = json.loads(page.locator(".safepg-values").text_content())["result"]["values"]
+            assert v["worker"] and v["adaptive"]["trajectories"] == 1_000_000
+            out["worker_s"].append(v["run_ms"]["adaptive"] / 1e3)
+            out["page_s"].append(v["elapsed_ms"] / 1e3)
+        browser.close()
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
@@ -93,6 +131,7 @@ def main() -> None:
     seeds = iter(range(1000))
     py["run_1e6"] = best_of(lambda: adaptive_pg(env, 0.0, 1.0, bound="bernstein", empirical_range=True,
                                                 budget=1_000_000, rng=next(seeds)), args.repeat)
+    browser = chromium_runs(args.repeat)
     result = {
         "what": "best of --repeat calls; batch: N = 1e5 trajectories, H = 20, random numbers included; run: "
                 "Algorithm 4.1, G(PO)MDP, Bernstein (e.r.), delta 0.95, sigma 1, 1e6 trajectories",
@@ -102,6 +141,8 @@ def main() -> None:
                     "load_average_1min": round(__import__("os").getloadavg()[0], 2)},
         "javascript_node": js,
         "safepg_numba": py,
+        "chromium_explorer_run_1e6": browser and {**browser, "worker_best_s": min(browser["worker_s"]),
+                                                  "page_best_s": min(browser["page_s"])},
         "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"], "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]}
                                 for k in js},
         "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / (2e6 if k.startswith("batch") else 2e7)

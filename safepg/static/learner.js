@@ -240,8 +240,8 @@ const safepgLearner = (function () {
   function upsilon(n, g, bd, c) {
     const e = bd.d / Math.sqrt(n) + bd.f / n;
     if (!(e < g)) return 0;
-    const a = g - e, b = g + e;
-    return Math.pow(a, 4) / (4 * c * n * (b * b));
+    const lo = g - e, hi = g + e;  // products, as safepg.meta.upsilon (not pow)
+    return (lo * lo) * (lo * lo) / (4 * c * n * (hi * hi));
   }
   function nStarClosedForm(g, bd) {
     if (g === 0) return Infinity;
