@@ -149,3 +149,23 @@ def test_run_cell_is_seeded_by_variant_start_and_cell():
     assert a != ts.run_cell(ts.DEFAULT, 1.0, 10_000, 1e-3, 1, budget=30_000, theta0=-0.575)
     b = ts.run_cell(ts.DEFAULT, 1.0, 10_000, 1e-3, 0, budget=30_000, theta0=-0.55)
     assert b[0] == -0.55 and len(a) == len(b) == 4
+
+
+@pytest.mark.parametrize("baseline,flag", [("optimal", True), ("none", False)])
+def test_fixed_step_run_is_the_library_vanilla_loop(baseline, flag):
+    from safepg.learning import vanilla_pg
+
+    ours = ts.fixed_step_run(ENV, -0.575, 1.0, 500, 1e-3, 10_000, np.random.default_rng(4), baseline)
+    lib = vanilla_pg(ENV, -0.575, 1.0, batch_size=500, alpha=1e-3, budget=10_000, baseline=flag,
+                     rng=np.random.default_rng(4))
+    np.testing.assert_allclose(ours, lib.theta[:, 0], rtol=0, atol=1e-12)
+    assert ts.improvement_ratio(ts.closed_form_j(ours, 1.0)) == lib.improvement_ratio()
+
+
+def test_sweep_starts_are_the_experiments_starts():
+    from safepg import experiments as ex
+
+    assert ts.PRINTED_THETA0 == ex.T51_PRINTED_THETA0 and ts.RECONSTRUCTED_THETA0 == ex.T51_THETA0
+    assert ts.PRINTED_THETA0 in ts.THETA0_SCAN and ts.RECONSTRUCTED_THETA0 in ts.THETA0_SCAN
+    assert (ts.DEFAULT, ts.RECONSTRUCTED_THETA0) in ts.CHAPTER_PLAN
+    assert {v for v, t in ts.CHAPTER_PLAN if t == ts.PRINTED_THETA0} == set(ts.VARIANTS)
