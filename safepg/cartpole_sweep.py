@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from safepg import portable
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
 from safepg.experiments import (
@@ -146,7 +147,7 @@ def load_sweep(root: Path | None = None) -> dict[str, Any]:
 
 def _average(rec: LearningRecord, sel: np.ndarray) -> float:
     w = rec.batch_size[sel]
-    return float(w @ rec.J_hat[sel] / w.sum())
+    return portable.fsum_mean(rec.J_hat[sel], weights=w)  # exact sums, not BLAS (safepg.portable)
 
 
 def late_minus_early(rec: LearningRecord, late: float = 0.25, early: float = 0.1) -> float:

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from safepg import plotting
+from safepg import plotting, portable
 from safepg.analysis import by_iteration, mean_band, performance_on_grid
 from safepg.envs.lqg import LQG
 from safepg.explorer import _RUNTIME_JS, Explorer, Plot, Select, Slider
@@ -99,7 +99,7 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
         for r, s in zip(recs, starts):
             # Trajectories 1..B: each batch weighs by its part inside the first B.
             w = np.clip(B - s, 0, r.batch_size)
-            ups.append(float(w @ r.J_hat / w.sum()))
+            ups.append(portable.fsum_mean(r.J_hat, weights=w))  # exact sums, not BLAS (safepg.portable)
             its.append(int(np.count_nonzero(s < B)))
         per_budget[str(B)] = {"upsilon_bar": _round([np.mean(ups)])[0], "iterations": float(np.mean(its))}
     return {"estimator": cfg.estimator, "bound": cfg.bound + ("-er" if cfg.empirical_range else ""),

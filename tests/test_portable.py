@@ -215,7 +215,7 @@ def test_2d_closed_forms_equal_fixed_order_reference() -> None:
 #: Modules whose numbers reach a notebook output, a report or an embedded explorer.
 OUTPUT_MODULES = ["bounds", "constants", "estimators", "learning", "meta", "policies", "trajectories",
                   "envs/lqg", "envs/cartpole", "experiments", "analysis", "explorers", "lqg_settings",
-                  "figures", "scorecard"]
+                  "figures", "scorecard", "table51_sweep", "cartpole_sweep", "live_learner"]
 #: (module, enclosing function) pairs allowed to call CPU-dispatched linear algebra, and why.
 ALLOWED = {
     # yes/no answers: only a gain exactly on the stability boundary could flip
