@@ -143,8 +143,8 @@ def main() -> None:
         "safepg_numba": py,
         "chromium_explorer_run_1e6": browser and {**browser, "worker_best_s": min(browser["worker_s"]),
                                                   "page_best_s": min(browser["page_s"])},
-        "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"], "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]}
-                                for k in js},
+        "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"],
+                                    "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]} for k in js},
         "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / (2e6 if k.startswith("batch") else 2e7)
                             for impl, v in (("js", js), ("numba", py)) for k in v},
     }

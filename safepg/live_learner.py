@@ -190,7 +190,8 @@ class LiveLearnerExplorer(Explorer):
                 ax.set_yscale("log" if spec.ylog else "linear")
                 ax.set_xlabel(spec.xlabel)
                 ax.set_ylabel(spec.ylabel)
-                ax.legend(fontsize="small")
+                if any(s.get("label") for s in res["plots"][spec.id]["series"]):
+                    ax.legend(fontsize="small")
             fig.tight_layout()
             plt.show()
             print(res.get("text", ""))
@@ -219,14 +220,20 @@ self.onmessage = function (e) {
 function safepgLiveThin(n, points) {
   if (n <= points) { const o = []; for (let i = 0; i < n; i++) o.push(i); return o; }
   const o = [];
-  for (let i = 0; i < points; i++) { const k = Math.floor(i * (n - 1) / (points - 1) + 0.5); if (!o.length || o[o.length - 1] !== k) o.push(k); }
+  for (let i = 0; i < points; i++) {
+    const k = Math.floor(i * (n - 1) / (points - 1) + 0.5);
+    if (!o.length || o[o.length - 1] !== k) o.push(k);
+  }
   return o;
 }
 function safepgLiveSummary(r) {
   // safepg.learning.LearningRecord's summary of a (possibly partial) record.
   const I = r.batchSize.length;
   let tot = 0, w = 0, up = 0;
-  for (let i = 0; i < I; i++) { tot += r.batchSize[i]; w += r.batchSize[i] * r.Jhat[i]; if (r.J[i + 1] - r.J[i] >= 0) up++; }
+  for (let i = 0; i < I; i++) {
+    tot += r.batchSize[i]; w += r.batchSize[i] * r.Jhat[i];
+    if (r.J[i + 1] - r.J[i] >= 0) up++;
+  }
   const Jat = {};
   let end = 0, i = 0;
   for (const T of [100000, 1000000, 3000000]) {
@@ -265,7 +272,8 @@ function safepgLiveResult(p, st, data) {
     const I = r.batchSize.length;
     const style = name === "adaptive" ? {color: data.colors[p.bound], dash: p.estimator === "reinforce"}
                                       : {color: data.vanilla_color, dash: false};
-    const label = name === "adaptive" ? "Algorithm 4.1 (live)" : `vanilla, N = ${p.vanilla_n}, alpha = ${p.vanilla_alpha}`;
+    const label = name === "adaptive" ? "Algorithm 4.1 (live)"
+                                      : `vanilla, N = ${p.vanilla_n}, alpha = ${p.vanilla_alpha}`;
     const keep = safepgLiveThin(I, data.points);
     plots.N.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.batchSize[i]), ...style});
     plots.alpha.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.alpha[i]), ...style});
@@ -289,8 +297,10 @@ function safepgLiveResult(p, st, data) {
   let text = line("Algorithm 4.1", values.adaptive);
   if (values.vanilla) text += "<br>" + line("vanilla PG", values.vanilla);
   text += "<br>" + (values.thesis.found
-    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${f(values.thesis.upsilon_bar, 4)}`
-    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, delta in {0.05, 0.25, 0.5, 0.75, 0.95})");
+    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ` +
+      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${f(values.thesis.upsilon_bar, 4)}`
+    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, " +
+      "delta in {0.05, 0.25, 0.5, 0.75, 0.95})");
   return {plots: plots, values: values, text: text};
 }
 function safepgLiveLearner(root, spec, learnerSrc) {
@@ -310,7 +320,8 @@ function safepgLiveLearner(root, spec, learnerSrc) {
                     budget: +p.budget, seed: Math.round(p.seed), theta0: 0};
     const b = p.bound.replace("-er", "");
     const runs = [{name: "adaptive", cfg: {...common, algorithm: "adaptive", bound: b, delta: p.delta,
-                                           empiricalRange: p.bound.endsWith("-er"), nMin: 100, nMax: 500000, stream: 0}}];
+                                           empiricalRange: p.bound.endsWith("-er"), nMin: 100, nMax: 500000,
+                                           stream: 0}}];
     if (p.vanilla_n !== "off")
       runs.push({name: "vanilla", cfg: {...common, algorithm: "vanilla", batchSize: +p.vanilla_n,
                                         alpha: +p.vanilla_alpha, stream: 1}});
@@ -370,7 +381,12 @@ function safepgLiveLearner(root, spec, learnerSrc) {
       try {
         worker = new Worker(url);
         worker.onmessage = e => receive(e.data);
-        worker.onerror = e => { e.preventDefault(); if (worker) worker.terminate(); worker = null; st.worker = false; runLocally(msg); };
+        worker.onerror = e => {  // a browser that refuses Blob workers: run in the page instead
+          e.preventDefault();
+          if (worker) worker.terminate();
+          worker = null; st.worker = false;
+          runLocally(msg);
+        };
         worker.postMessage(msg);
         st.worker = true;
       } catch (e) { worker = null; runLocally(msg); }

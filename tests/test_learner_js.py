@@ -26,7 +26,13 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from safepg.bounds import ErrorBound, error_bound, gpomdp_variance_factor, gradient_range_bound, reinforce_variance_factor
+from safepg.bounds import (
+    ErrorBound,
+    error_bound,
+    gpomdp_variance_factor,
+    gradient_range_bound,
+    reinforce_variance_factor,
+)
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg
@@ -60,7 +66,10 @@ if (req.updates) out.updates = req.updates.map(u => {
           theta: u.theta + up.step, safe: up.safe, next_n: up.nextN};
 });
 if (req.nstar) out.nstar = req.nstar.map(q => L.nStarSearch(q.g, {d: q.d, f: q.f}, q.c, q.n_max));
-if (req.J) out.J = req.J.map(q => { const v = L.lqgPerformance(q.theta, q.sigma, task); return isFinite(v) ? v : null; });
+if (req.J) out.J = req.J.map(q => {
+  const v = L.lqgPerformance(q.theta, q.sigma, task);
+  return isFinite(v) ? v : null;
+});
 if (req.kernel) {
   const s0 = f64(req.kernel.s0), z = f64(req.kernel.z), H = task.H;
   out.kernel = req.kernel.cases.map(q => {
@@ -72,7 +81,8 @@ if (req.kernel) {
     };
     const ws = new L.Workspace(H);
     L.gradientSamples(q.theta, q.sigma, s0.length, Object.assign({}, task, {clip: q.clip}), q, ws, draw);
-    return {samples: Array.from(ws.samples.subarray(0, s0.length)), returns: Array.from(ws.returns.subarray(0, s0.length))};
+    return {samples: Array.from(ws.samples.subarray(0, s0.length)),
+            returns: Array.from(ws.returns.subarray(0, s0.length))};
   });
 }
 if (req.replay) {
@@ -310,8 +320,9 @@ def test_runs_agree_statistically(bound, er, estimator, sigma):
         assert row["inside"], row
 
 
-if __name__ == "__main__":  # the agreement table of issue 12 (about 5 minutes on one core)
-    print("| bound | estimator | sigma | metric | JS (30 seeds) | safepg (30 seeds) | difference | 99% CI half-width | inside |")
+if __name__ == "__main__":  # the agreement table of issue 12 (about 6 CPU minutes)
+    print("| bound | estimator | sigma | metric | JS (30 seeds) | safepg (30 seeds) | difference "
+          "| 99% CI half-width | inside |")
     print("|---|---|---|---|---|---|---|---|---|")
     for b, er, est, s in STAT_CONFIGS:
         for r in agreement(b, er, est, s):

@@ -1,0 +1,107 @@
+"""The live batch-size explorer's Python side (safepg/live_learner.py): the page it renders,
+the stored runs it embeds and its Python twin. The JavaScript learner itself is tested
+against safepg in tests/test_learner_js.py, the page in tests/test_browser_learner.py."""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from safepg.experiments import get_experiment, t52_name
+from safepg.learning import LearningRecord
+from safepg.live_learner import BUDGETS, learner_js, live_batch_size_explorer, task_data
+
+
+def fake_record(batch_sizes: list[int], seed: int) -> LearningRecord:
+    """A record with the given batch sizes and made-up numbers (the overlay only reads them)."""
+    rng = np.random.default_rng(seed)
+    n = np.asarray(batch_sizes, dtype=np.int64)
+    I = n.size
+    theta = np.cumsum(np.concatenate([[0.0], -rng.uniform(0, 1e-3, I)]))[:, None]
+    return LearningRecord(batch_size=n, alpha=rng.uniform(1e-6, 1e-4, I), coordinate=np.zeros(I, np.int64),
+                          theta=theta, J=-50 + np.arange(I + 1) / I, J_hat=rng.uniform(-20, -10, I),
+                          grad=rng.standard_normal((I, 1)), eps=np.ones(I), safe=np.ones(I, bool))
+
+
+@pytest.fixture(scope="module")
+def stored():
+    exp = get_experiment("table-5.2")
+    good = exp.config(t52_name("gpomdp", "bernstein", True, 0.95))
+    other = replace(exp.config(t52_name("gpomdp", "hoeffding", False, 0.95)), name="range", theoretical_range=1280.0)
+    sizes = [100] + [50_000] * 100  # 5.0001e6 trajectories: past the largest budget
+    records = {good.name: [fake_record(sizes, 0), fake_record([100] + [70_000] * 60, 1)],
+               other.name: [fake_record(sizes, 2)]}
+    return records, [good, other]
+
+
+def test_page_is_self_contained():
+    html = live_batch_size_explorer().to_html()
+    urls = set(re.findall(r"https?://[^\s\"'`)]+", html)) - {"http://www.w3.org/2000/svg"}
+    assert not urls, urls  # no CDN, no request: only the SVG namespace name
+    assert "<script src" not in html and "import(" not in html
+    assert "new Worker(url)" in html and "new Blob(" in html
+    assert json.dumps(learner_js()) in html  # the learner travels inside the page
+
+
+def test_task_is_the_thesis_1d_lqg():
+    t = task_data()
+    assert (t["gamma"], t["H"], t["bs"], t["ba"], t["clip"]) == (0.9, 20, 2.0, 2.0, True)
+    assert (t["R"], t["M"], t["Avol"], t["Abar"]) == (4.0, 2.0, 4.0, 2.0)
+
+
+def test_overlay_embeds_matching_stored_runs(stored):
+    records, configs = stored
+    ex = live_batch_size_explorer(records, configs)
+    runs = ex.data["runs"]
+    assert list(runs) == ["gpomdp-bernstein-er-delta=0.95-clipped"]  # the reconstructed-range run is not rerunnable
+    run = runs["gpomdp-bernstein-er-delta=0.95-clipped"]
+    # Seed means per iteration, cut where the mean batch start reaches the largest budget.
+    assert run["iteration"][0] == 1 and run["batch_size"][0] == 100
+    assert run["batch_size"][1] == 60_000.0 and max(run["start"]) < BUDGETS[-1]
+    # Upsilon-bar of the first B trajectories: each batch weighs by its part inside them.
+    B = 100_000
+    expected = []
+    for r in records[configs[0].name]:
+        start = np.concatenate([[0], np.cumsum(r.batch_size)[:-1]])
+        w = np.clip(B - start, 0, r.batch_size)
+        expected.append(w @ r.J_hat / B)
+    assert run["budgets"][str(B)]["upsilon_bar"] == pytest.approx(np.mean(expected), rel=5e-6)  # 6 digits
+    assert run["budgets"][str(B)]["iterations"] == 3.0  # 100 + 50000 + (part of) 50000, and 100 + 70000
+    # Embedded floats carry 6 significant digits at most.
+    for v in run["J"] + run["alpha"]:
+        assert v is None or float(f"{v:.6g}") == v
+
+
+def test_python_twin(stored):
+    records, configs = stored
+    ex = live_batch_size_explorer(records, configs)
+    p = {**ex.defaults(), "budget": "10000"}
+    res = ex.compute_py(p)
+    v = res["values"]
+    assert v["adaptive"]["trajectories"] == 10_000 and v["adaptive"]["first_batches"][0] == 100
+    assert v["vanilla"]["first_batches"] == [1000, 1000, 1000] and v["vanilla"]["iterations"] == 10
+    assert v["thesis"]["found"] and v["thesis"]["key"] == "gpomdp-bernstein-er-delta=0.95-clipped"
+    assert [len(res["plots"][k]["series"]) for k in ("N", "J", "alpha")] == [3, 3, 3]
+    assert res["plots"]["J"]["series"][0]["x"][-1] <= 10_000
+    assert not ex.compute_py({**p, "sigma": 0.5, "vanilla_n": "off"})["values"]["thesis"]["found"]
+    assert ex.compute_py({**p, "vanilla_n": "off"})["values"]["vanilla"] is None
+    # The same seed gives the same run; another seed another one.
+    again = ex.compute_py(p)["values"]["adaptive"]
+    assert again == v["adaptive"] and ex.compute_py({**p, "seed": 1.0})["values"]["adaptive"] != v["adaptive"]
+
+
+def test_interactive_builds_widgets():
+    pytest.importorskip("ipywidgets")
+    ex = live_batch_size_explorer()
+    calls = []
+    # Building the widgets draws once: a stub stands in for the learning run.
+    ex.compute_py = lambda p: calls.append(p) or {"plots": {k: {"series": [{"x": [1, 2], "y": [1, 2]}]}
+                                                            for k in ("N", "J", "alpha")}, "text": ""}
+    w = ex.interactive()
+    assert calls and calls[0]["bound"] == "bernstein-er"
+    names = {c.description for c in w.children[:-1]}
+    assert {"delta", "sigma", "bound", "estimator", "baseline", "score", "seed"} <= names
