@@ -11,7 +11,8 @@ Measures, on one core:
 - the same run in headless Chromium (Debian's, through Playwright): the explorer page of
   ``safepg.live_learner`` with vanilla PG off, time inside the Web Worker's learner and
   the page's time from the control move to the last curve (worker start, messages and
-  drawing included), for a few seeds.
+  drawing included), and the CPU time all of Chromium's processes used meanwhile, for a
+  few seeds.
 
 Both wall time and process CPU time are recorded where they can be (the build machine is
 shared: CPU time is the steadier figure; the browser gives wall time only). Results go to
@@ -81,9 +82,24 @@ def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
         return None
     if not Path(chromium).exists():
         return None
+    import psutil
+
     from safepg.live_learner import live_batch_size_explorer
 
-    out: dict[str, list[float]] = {"worker_s": [], "page_s": []}
+    def browser_cpu() -> float:
+        """CPU seconds used so far by this process's Chromium processes (all of them: an
+        upper bound on the worker's own time, which the machine's load does not inflate)."""
+        total = 0.0
+        for proc in psutil.Process().children(recursive=True):
+            try:
+                if "chrom" in proc.name():
+                    t = proc.cpu_times()
+                    total += t.user + t.system
+            except psutil.NoSuchProcess:
+                pass
+        return total
+
+    out: dict[str, list[float]] = {"worker_s": [], "page_s": [], "browser_cpu_s": []}
     with tempfile.TemporaryDirectory() as tmp, sync_playwright() as p:
         page_path = Path(tmp) / "live.html"
         page_path.write_text(f"<!doctype html><html><body>{live_batch_size_explorer().to_html()}</body></html>")
@@ -95,8 +111,10 @@ def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
         page.locator('[data-param="vanilla_n"]').select_option("off")  # job 2
         page.wait_for_function(done, arg=2, timeout=120_000)
         for k in range(seeds):
+            cpu0 = browser_cpu()
             page.locator('[data-param="seed"]').fill(str(k + 1))
             page.wait_for_function(done, arg=3 + k, timeout=120_000)
+            out["browser_cpu_s"].append(browser_cpu() - cpu0)
             v = json.loads(page.locator(".safepg-values").text_content())["result"]["values"]
             assert v["worker"] and v["adaptive"]["trajectories"] == 1_000_000
             out["worker_s"].append(v["run_ms"]["adaptive"] / 1e3)
@@ -142,7 +160,8 @@ def main() -> None:
         "javascript_node": js,
         "safepg_numba": py,
         "chromium_explorer_run_1e6": browser and {**browser, "worker_best_s": min(browser["worker_s"]),
-                                                  "page_best_s": min(browser["page_s"])},
+                                                  "page_best_s": min(browser["page_s"]),
+                                                  "browser_cpu_best_s": min(browser["browser_cpu_s"])},
         "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"],
                                     "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]} for k in js},
         "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / (2e6 if k.startswith("batch") else 2e7)
