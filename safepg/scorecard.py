@@ -1028,6 +1028,7 @@ table.sc-table tr.sc-note td{border-top:0;padding-top:0;font-size:.95em;color:va
 .sc-pin{position:sticky;left:.5em;max-width:min(44em,calc(100vw - 3.5rem))}
 table.sc-table td.sc-num{white-space:nowrap;font-variant-numeric:tabular-nums}
 table.sc-table td.sc-result{min-width:11em;max-width:20em}
+table.sc-table td.sc-words{min-width:12em;max-width:20em;overflow-wrap:anywhere}
 table.sc-table td.sc-expr{min-width:8em}
 .sc-math{max-width:20em;overflow-x:auto;overflow-y:hidden;padding-bottom:2px}
 .sc-detail{display:block;font-size:.85em;color:var(--pst-color-text-muted,#555)}
@@ -1083,7 +1084,8 @@ def _cell(text: str, tex: str) -> str:
         # A formula cannot wrap: one longer than the cell scrolls inside its own box.
         return (f'<td class="sc-expr"><div class="sc-math"><span class="math notranslate nohighlight">'
                 f"\\({html.escape(tex)}\\)</span></div></td>")
-    return f'<td class="sc-num">{_split(text)}</td>'
+    # Numbers stay on one line; a long statement in words wraps.
+    return f'<td class="{"sc-num" if len(text) <= 32 else "sc-words"}">{_split(text)}</td>'
 
 
 def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
