@@ -260,7 +260,8 @@ function safepgLiveResult(p, st, data) {
     }
     const gx = [], gy = [];
     for (let i = 0; i < data.grid.length && data.grid[i] <= B; i++) { gx.push(data.grid[i]); gy.push(run.J[i]); }
-    const label = `stored safepg run (${run.seeds} seeds)`, thin = {color: data.muted, dash: true};
+    const label = `stored safepg run (${run.seeds} seed${run.seeds === 1 ? "" : "s"})`;
+    const thin = {color: data.muted, dash: true};
     plots.N.series.push({label: label, x: its, y: ns, ...thin});
     plots.J.series.push({label: label, x: gx, y: gy, ...thin});
     plots.alpha.series.push({label: label, x: its, y: as, ...thin});
@@ -487,7 +488,8 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any]) -> dict
     if run is not None:
         k = next((i for i, s in enumerate(run["start"]) if s is None or s >= budget), len(run["start"]))
         g = int(np.searchsorted(data["grid"], budget, side="right"))
-        thin = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({run['seeds']} seeds)"}
+        seeds = f"{run['seeds']} seed{'' if run['seeds'] == 1 else 's'}"
+        thin = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({seeds})"}
         plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **thin})
         plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **thin})
         plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **thin})

@@ -26,7 +26,7 @@ pytestmark = pytest.mark.browser
 MAX_RUN_SECONDS = 20.0
 
 
-def stored_runs(budget: int = 3_000_000, seeds: int = 2) -> tuple[dict[str, list[Any]], list[Any]]:
+def stored_runs(budget: int = 3_000_000, seeds: int = 1) -> tuple[dict[str, list[Any]], list[Any]]:
     """A Table 5.2 configuration run for the overlay (few seeds, up to the largest budget)."""
     from safepg.experiments import get_experiment, t52_name
 
