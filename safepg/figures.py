@@ -238,6 +238,7 @@ def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) 
             v = np.array([r[f"{method}_{what}"] for r in rows], dtype=float) * scale
             if method == "adaptive":
                 learns = np.array([bool(r["adaptive_learns"]) for r in rows])
+                # Legend entries only for the kinds that occur.
                 ax.scatter(v[learns], y[learns] + dy, color=colours[method], zorder=3,
                            label=labels[method] + ", learns")
                 ax.scatter(v[~learns], y[~learns] + dy, facecolor="white", edgecolor=colours[method], zorder=3,
