@@ -240,7 +240,7 @@ def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) 
                 learns = np.array([bool(r["adaptive_learns"]) for r in rows])
                 # Legend entries only for the kinds that occur.
                 ax.scatter(v[learns], y[learns] + dy, color=colours[method], zorder=3,
-                           label=labels[method] + ", learns")
+                           label=labels[method] + ", learns" if learns.any() else None)
                 ax.scatter(v[~learns], y[~learns] + dy, facecolor="white", edgecolor=colours[method], zorder=3,
                            label=labels[method] + ", does not learn")
             else:
