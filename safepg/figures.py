@@ -242,7 +242,7 @@ def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) 
                 ax.scatter(v[learns], y[learns] + dy, color=colours[method], zorder=3,
                            label=labels[method] + ", learns" if learns.any() else None)
                 ax.scatter(v[~learns], y[~learns] + dy, facecolor="white", edgecolor=colours[method], zorder=3,
-                           label=labels[method] + ", does not learn")
+                           label=labels[method] + ", does not learn" if (~learns).any() else None)
             else:
                 ax.scatter(v, y + dy, color=colours[method], marker="s", label=labels[method], zorder=3)
             ax.axvline(thesis[f"{method}_{what}"] * scale, color=colours[method], linestyle="--", linewidth=1,
