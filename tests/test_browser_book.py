@@ -12,8 +12,8 @@ Screenshots (light and dark theme) go to ``_build/screenshots/``.
 (390 px) width, in the light and the dark theme, and checks what a reader sees: nothing
 sticks out of the text column and the page never scrolls sideways, nothing is cut off
 (a box that scrolls sideways carries the book's visible cue), no visible code line is
-cut off, no visible code cell only imports, figures in the dark theme sit on a light
-card, explorer axes have distinct tick labels inside the plot, and every figure and
+cut off, no visible code cell only imports, figures keep their proportions and sit on a
+light card in the dark theme, explorer axes have distinct tick labels inside the plot, and every figure and
 table number of the thesis is a caption on the page it belongs to
 (:data:`THESIS_CAPTIONS`), while our own figures and tables carry numbers that cannot be
 mistaken for the thesis's.
@@ -264,6 +264,18 @@ def _dark_figures(pg: OfflinePage) -> list[str]:
     return [src for src, bg in backgrounds if "rgba(0, 0, 0, 0)" in bg or _luminance(bg) < 0.8]
 
 
+def _distorted_images(pg: OfflinePage) -> list[str]:
+    """Images drawn with another aspect ratio than their own (a shrunk width, a fixed height)."""
+    return pg.page.evaluate("""() => [...document.querySelectorAll('.bd-article img')].map(i => {
+        const cs = getComputedStyle(i), px = v => parseFloat(v) || 0;  // the picture: the box less its padding
+        const w = i.clientWidth - px(cs.paddingLeft) - px(cs.paddingRight);
+        const h = i.clientHeight - px(cs.paddingTop) - px(cs.paddingBottom);
+        return {i, w, h};
+      }).filter(({i, w, h}) => i.naturalWidth && i.naturalHeight && h > 0
+                && Math.abs((w / h) / (i.naturalWidth / i.naturalHeight) - 1) > 0.02)
+        .map(({i, w, h}) => `${i.src.split('/').pop()} drawn ${Math.round(w)}x${Math.round(h)}`)""")
+
+
 def test_every_page_reads_well(browser, book):
     """The page-wide reading checks of issue 11 (see the module docstring), on every page of
     ``_toc.yml``, at 1280 and 390 px, in the light and the dark theme."""
@@ -300,6 +312,9 @@ def test_every_page_reads_well(browser, book):
                     light_less = _dark_figures(pg)
                     if light_less:
                         bad["figures without a light card in the dark theme"] = light_less
+                distorted = _distorted_images(pg)
+                if distorted:
+                    bad["images drawn out of proportion"] = distorted
                 axes = _explorer_axes(pg)
                 if axes:
                     bad["explorer axes"] = axes
