@@ -2,17 +2,18 @@
 
 Each factory returns an explorer whose JavaScript and Python halves compute the same
 curves: closed forms in both, precomputed Monte Carlo quantities embedded as data.
+The batch-size explorer, which reruns Algorithm 4.1 in the page, is
+:func:`safepg.live_learner.live_batch_size_explorer`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from safepg import plotting
-from safepg.analysis import by_iteration, mean_band, performance_on_grid
 from safepg.bounds import (
     ErrorBound,
     bernstein,
@@ -25,7 +26,6 @@ from safepg.bounds import (
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.explorer import Explorer, Plot, Select, Slider
-from safepg.learning import LearningRecord
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -183,62 +183,3 @@ def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, the
          Select("bound", "bound", BOUND_CHOICES, "bernstein-er")],
         [Plot("U", "batch size N", "Upsilon_delta(N)", xlog=True)],
         _UPSILON_JS, compute_py, data)
-
-
-# --------------------------------------------------------------------- batch size
-_BATCH_JS = r"""
-const key = `${p.estimator}-${p.bound}-delta=${p.delta}`;
-const run = data.runs[key];
-if (!run) return {plots: {N: {series: []}, J: {series: []}}, values: {key: key, found: false},
-                  text: `${key}: not among the thesis's runs (Table 5.2)`};
-return {
-  plots: {N: {series: [{label: "batch size", x: run.iteration, y: run.batch_size, color: run.color}]},
-          J: {series: [{label: "J(theta)", x: data.grid, y: run.J, color: run.color, dash: p.estimator === "reinforce"}]}},
-  values: {key: key, found: true, final_batch: run.batch_size[run.batch_size.length - 1], J_final: run.J[run.J.length - 1]},
-  text: `${key}: ${run.iterations.toFixed(0)} iterations (seed mean); upsilon_bar = ${run.upsilon_bar.toFixed(4)}`,
-};
-"""
-
-
-def batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence[Any],
-                        points: int = 300) -> Explorer:
-    """Batch size over iterations and expected performance over trajectories of the stored
-    Table 5.2 runs (seed means): pick the estimator, the bound and delta."""
-    runs: dict[str, Any] = {}
-    total = max(r.trajectories for recs in records.values() for r in recs)
-    grid = np.unique(np.linspace(1, total, points).astype(np.int64))
-    for c in configs:
-        recs = records[c.name]
-        if not recs:
-            continue
-        nmean = mean_band(by_iteration(recs, "batch_size"))[0]
-        keep = np.unique(np.linspace(0, nmean.size - 1, min(points, nmean.size)).astype(int))
-        bound = c.bound + ("-er" if c.empirical_range else "")
-        runs[f"{c.estimator}-{bound}-delta={c.delta}"] = {
-            "iteration": (keep + 1).tolist(), "batch_size": np.round(nmean[keep], 1).tolist(),
-            "J": np.round(mean_band(performance_on_grid(recs, grid))[0], 5).tolist(),
-            "iterations": float(np.mean([r.iterations for r in recs])),
-            "upsilon_bar": float(np.mean([r.upsilon_bar() for r in recs])),
-            "color": plotting.bound_color(c.bound, c.empirical_range)}
-    data = {"grid": grid.tolist(), "runs": runs}
-    deltas = sorted({c.delta for c in configs})
-
-    def compute_py(p: dict[str, Any]) -> dict[str, Any]:
-        key = f"{p['estimator']}-{p['bound']}-delta={p['delta']}"
-        run = runs.get(key)
-        if run is None:
-            return {"values": {"key": key, "found": False}}
-        return {"plots": {"N": {"series": [{"x": run["iteration"], "y": run["batch_size"]}]},
-                          "J": {"series": [{"x": data["grid"], "y": run["J"]}]}},
-                "values": {"key": key, "found": True, "final_batch": run["batch_size"][-1], "J_final": run["J"][-1]}}
-
-    return Explorer(
-        "Adaptive batch size on the 1-D LQG (stored runs, mean of the seeds)",
-        [Select("estimator", "estimator", (("gpomdp", "G(PO)MDP"), ("reinforce", "REINFORCE")), "gpomdp"),
-         Select("bound", "bound", (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"),
-                                   ("hoeffding-er", "Hoeffding (e.r.)"), ("bernstein", "Bernstein"),
-                                   ("bernstein-er", "Bernstein (e.r.)")), "chebyshev"),
-         Select("delta", "delta", tuple((str(d), str(d)) for d in deltas), "0.95")],
-        [Plot("N", "iteration", "batch size N", ylog=True),
-         Plot("J", "trajectories", "expected performance J(theta)")],
-        _BATCH_JS, compute_py, data)

@@ -98,26 +98,41 @@ def test_upsilon_explorer_matches_safepg(browser, book):
 
 
 def test_batch_size_explorer_matches_stored_runs(browser, book):
+    """The Section 5.1 chapter's batch-size explorer reruns Algorithm 4.1 in the page (in a
+    Web Worker) and draws the stored Table 5.2 runs beside it with safepg's numbers
+    (tests/test_browser_learner.py drives every control on a page of its own)."""
+    import json
+
     from safepg.experiments import get_experiment, load_experiment
-    from safepg.explorers import batch_size_explorer
+    from safepg.live_learner import TITLE, live_batch_size_explorer
 
     pg = OfflinePage(browser, book / "book" / "lqg1d.html", height=1600)
     _check_page(pg, min_images=4)
-    exp = get_experiment("table-5.2")
-    py = batch_size_explorer(load_experiment(exp, ROOT / "results"), exp.configs)
-    finals = set()
-    for params in ({"bound": "bernstein-er"}, {"bound": "chebyshev", "delta": "0.5"},
-                   {"estimator": "reinforce", "delta": "0.75"}, {"bound": "hoeffding", "delta": "0.95",
-                                                                 "estimator": "gpomdp"}):
+    records, configs = {}, []
+    for name in ("table-5.2", "table-5.2-raw-score"):
+        exp = get_experiment(name)
+        records.update(load_experiment(exp, ROOT / "results"))
+        configs += list(exp.configs)
+    py = live_batch_size_explorer(records, configs)
+    root = pg.page.locator(".safepg-explorer", has_text=TITLE).first
+    done = """job => { const v = JSON.parse(document.querySelector('.safepg-live .safepg-values').textContent);
+                       return v.job === job && v.result.values.done; }"""
+    for params in ({"budget": "100000", "vanilla_n": "off"}, {"bound": "chebyshev", "delta": "0.5"},
+                   {"estimator": "reinforce", "delta": "0.75"},
+                   {"bound": "bernstein-er", "delta": "0.95", "estimator": "gpomdp", "score": "raw"}):
+        job = json.loads(root.locator(".safepg-values").text_content())["job"]
         for k, v in params.items():
             _set(pg.page, k, v)
-        got = pg.values()
-        assert got["result"]["values"] == py.compute_py(got["params"])["values"]
-        assert got["result"]["values"]["found"]
-        finals.add(got["result"]["values"]["final_batch"])
-    assert len(finals) == 4
-    _set(pg.page, "bound", "bernstein")
-    _set(pg.page, "estimator", "reinforce")
-    assert pg.values()["result"]["values"]["found"] is False
-    pg.page.locator(".safepg-explorer").first.screenshot(path=str(SHOTS / "batch-size.png"))
-    assert not pg.errors
+        pg.page.wait_for_function(done, arg=job + len(params), timeout=120_000)
+        got = json.loads(root.locator(".safepg-values").text_content())
+        expected = py.compute_py(got["params"])
+        values = got["result"]["values"]
+        assert values["worker"] and values["adaptive"]["trajectories"] == 100_000
+        assert values["thesis"]["found"], params
+        assert values["thesis"] == expected["values"]["thesis"]
+        assert got["result"]["plots"]["J"]["series"][0] == expected["plots"]["J"]["series"][0]
+    _set(pg.page, "sigma", "0.5")
+    pg.page.wait_for_function("() => !JSON.parse(document.querySelector('.safepg-live .safepg-values')"
+                              ".textContent).result.values.thesis.found")
+    root.screenshot(path=str(SHOTS / "batch-size.png"))
+    assert not pg.errors and not pg.remote
