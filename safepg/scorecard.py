@@ -817,7 +817,7 @@ def _cartpole_rows(b: _Builder, base_exp: Experiment, base_recs: Mapping[str, Se
     adaptive = recs54.get("adaptive", [])
     steps = np.concatenate([r.alpha[r.alpha > 0] for r in adaptive] or [np.empty(0)])
     b.values["adaptive_steps"] = f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none"
-    names = ["x", "ẋ", "β", "β̇"]  # the state [x, x_dot, beta, beta_dot]
+    names = ["x", "dx/dt", "β", "dβ/dt"]  # the state [x, x_dot, beta, beta_dot]
     never = PRINTED["cartpole_components_never_updated"]
     updated = None
     for r in rep54["configs"]:
