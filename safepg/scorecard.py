@@ -136,6 +136,9 @@ NOTES: dict[str, Note] = {
     "table-5.2/theoretical-range": Note(
         "The range of the gradient samples behind this row is not printed; rerun, it gives {variant}, "
         "inside the printed interval.", "lqg1d", "Table 5.2"),
+    "table-5.2/reconstructed-range": Note(
+        "The gradient range behind this row is not printed, and the interval is too narrow for a constant "
+        "that is only reconstructed: {range_gap}.", "lqg1d", "Table 5.2"),
     "table-5.2/theoretical-range-unexplained": Note(
         "Open: the range of the gradient samples behind this row is not printed, and neither Lemma 4.3.3's "
         "range nor our reconstruction reproduces it ({variant}).", "lqg1d", "Table 5.2", explains=False),
@@ -597,7 +600,7 @@ def _table_5_1_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any], varian
 
 def _range_label(r: Mapping[str, Any] | None, cfg: Any) -> str:
     rng = getattr(cfg, "theoretical_range", None)
-    return f"range {rng:g} (our reconstruction, not printed)" if rng is not None else "Lemma 4.3.3's range"
+    return f"the range {rng:g} (our reconstruction, not printed)" if rng is not None else "Lemma 4.3.3's range"
 
 
 def _table_5_2_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
@@ -627,10 +630,16 @@ def _table_5_2_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
                 v_ok = intervals_overlap(vci, th["ci95"])
                 v_text = f"{fmt(vm)}{_ci_text(vci, fmt)}"
             if ok:
-                explanation = f"Reproduced with the {_range_label(r, c)}; with the {_range_label(vr, vc)} " \
-                              f"ours is {v_text}." if vc is not None else f"Reproduced with the {_range_label(r, c)}."
+                explanation = f"Reproduced with {_range_label(r, c)}; with {_range_label(vr, vc)} " \
+                              f"ours is {v_text}." if vc is not None else f"Reproduced with {_range_label(r, c)}."
+            elif ok is not None and c.theoretical_range is not None:
+                # The row runs with a reconstructed range: the gap is the unknown constant's.
+                b.values["range_gap"] = (f"with our reconstruction {c.theoretical_range:g} ours is "
+                                         f"{100 * abs(mean - th['upsilon_bar']) / abs(th['upsilon_bar']):.2f}% "
+                                         f"from the printed value; with {_range_label(vr, vc)} it is {v_text}")
+                note_id = "table-5.2/reconstructed-range"
             else:
-                b.values["variant"] = f"{v_text} with the {_range_label(vr, vc)}"
+                b.values["variant"] = f"{v_text} with {_range_label(vr, vc)}"
                 note_id = "table-5.2/theoretical-range" if v_ok else "table-5.2/theoretical-range-unexplained"
         er = " (e.r.)" if c.empirical_range else ""
         label = f"{c.estimator}-{c.bound}{'-er' if c.empirical_range else ''}-delta={c.delta:g}"
