@@ -238,11 +238,9 @@ def _cos_poly(r: float) -> float:
 
 
 @njit(cache=True)
-def sin(x: float) -> float:
-    """sin x with CPU-independent bits (|x| < 1e5; beyond that, libm's)."""
-    if not abs(x) < 1e5:
-        return math.sin(x)
-    r, q = _reduce(x)
+def _sin_quadrant(r: float, q: int) -> float:
+    """sin(r + q pi/2) for |r| <= pi/4; cos x = sin(x + pi/2) is quadrant q + 1."""
+    q = q & 3
     if q == 0:
         return _sin_poly(r)
     if q == 1:
@@ -253,18 +251,21 @@ def sin(x: float) -> float:
 
 
 @njit(cache=True)
+def sin(x: float) -> float:
+    """sin x with CPU-independent bits (|x| < 1e5; beyond that, libm's)."""
+    if not abs(x) < 1e5:
+        return math.sin(x)
+    r, q = _reduce(x)
+    return _sin_quadrant(r, q)
+
+
+@njit(cache=True)
 def cos(x: float) -> float:
     """cos x with CPU-independent bits (|x| < 1e5; beyond that, libm's)."""
     if not abs(x) < 1e5:
         return math.cos(x)
     r, q = _reduce(x)
-    if q == 0:
-        return _cos_poly(r)
-    if q == 1:
-        return -_sin_poly(r)
-    if q == 2:
-        return -_cos_poly(r)
-    return _sin_poly(r)
+    return _sin_quadrant(r, q + 1)
 
 
 @njit(cache=True)
