@@ -148,6 +148,15 @@ def test_status_is_the_rule_applied(rows):
             assert (r.status == "reproduced") == ok, r.id
 
 
+def test_cartpole_table_is_settled_by_the_sweep(rows):
+    # The chapter's sweep settles Table 5.4 as not reproducible: a failing cell is explained, and links there.
+    failing = [r for r in rows if r.id.startswith("table-5.4/") and r.status != "reproduced"]
+    assert failing
+    for r in failing:
+        assert r.status == "differs (explained)", r.id
+        assert r.link == "cartpole.html#what-the-sweep-says" and r.explanation.startswith("Not reproducible"), r.id
+
+
 def test_theory_rows_follow_safepg_theory(rows):
     ids = by_id(rows)
     for v in theory.verified():
