@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Sequence
 from decimal import Decimal, InvalidOperation
@@ -104,35 +105,33 @@ def _run_learn(args: argparse.Namespace) -> dict:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from safepg import experiments  # imported here: ``learn`` alone needs none of the runner
+
     parser = argparse.ArgumentParser(prog="safepg", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     _learn_parser(sub)
-    try:
-        from safepg import experiments
-    except ImportError:  # the experiment runner is optional while it is being built
-        experiments = None  # type: ignore[assignment]
-    if experiments is not None:
-        experiments.add_parsers(sub)
+    experiments.add_parsers(sub)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # a usage error (argparse printed it, exit status 2) or --help
         return exc.code if isinstance(exc.code, int) else int(exc.code is not None)
     try:
-        if args.command == "learn":
-            out = _run_learn(args)
-        else:
-            out = args.func(args)
+        out = _run_learn(args) if args.command == "learn" else args.func(args)
+        if out is not None:
+            json.dump(out, sys.stdout, indent=None if args.command == "learn" else 1)
+            sys.stdout.write("\n")
+        sys.stdout.flush()
     except (ValueError, TypeError) as err:
         print(f"safepg: error: {err}", file=sys.stderr)
         return 2
-    except Exception as err:
-        if experiments is not None and isinstance(err, experiments.NothingStoredError):
-            print(f"safepg: {err}", file=sys.stderr)
-            return 1
-        raise
-    if out is not None:
-        json.dump(out, sys.stdout, indent=None if args.command == "learn" else 1)
-        sys.stdout.write("\n")
+    except experiments.NothingStoredError as err:
+        print(f"safepg: {err}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:
+        # The reader stopped reading (``safepg report ... | head``): nothing is wrong with the
+        # run. stdout goes to devnull so the interpreter's last flush does not raise again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     return 0
 
 

@@ -330,3 +330,13 @@ def test_report_with_nothing_stored_says_which_run_to_type(tmp_path, monkeypatch
     assert code == 0 and json.loads(out)["configs"][0]["seeds"] == 1
     assert "1 of 24 runs of table-5.1 stored" in err
     assert "python -m safepg run table-5.1 --seeds 1 --budget 10000" in err
+
+
+def test_a_reader_that_stops_reading_gets_no_traceback(tmp_path):
+    # As in ``python -m safepg list | head -0``: the pipe is closed before anything is written.
+    proc = subprocess.Popen([sys.executable, "-m", "safepg", "list"], env=_env(tmp_path), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 1
+    assert "Traceback" not in err and "BrokenPipeError" not in err and "Exception ignored" not in err, err
