@@ -21,7 +21,7 @@ import html
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -278,31 +278,38 @@ class Explorer:
     def _spec(self) -> dict[str, Any]:
         return {"plots": [p.__dict__ for p in self.plots], "data": self.data}
 
+    def _controls_html(self) -> str:
+        """The sliders and selects, as labelled form elements the page's script reads."""
+        style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
+        rows = []
+        for c in self.controls:
+            if isinstance(c, Slider):
+                rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
+                            f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
+                            f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')
+            else:
+                opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
+                               f"{html.escape(lbl)}</option>" for v, lbl in c.options)
+                rows.append(f'<label {style}>{html.escape(c.label)} <select data-param="{c.name}">{opts}</select>'
+                            "</label>")
+        return "".join(rows)
+
+    def _plots_html(self) -> str:
+        """One empty SVG per plot, drawn by the page's script."""
+        return "".join(f'<svg data-plot="{p.id}" role="img" aria-label="{html.escape(p.ylabel)} over '
+                       f'{html.escape(p.xlabel)}" style="width:100%;max-width:640px;height:auto;display:block">'
+                       "</svg>" for p in self.plots)
+
     def to_html(self) -> str:
         """The self-contained HTML + JavaScript block."""
         spec = json.dumps(self._spec(), separators=(",", ":"), default=_json_default)
         uid = "safepg-" + hashlib.sha1((self.title + spec + self.compute_js).encode()).hexdigest()[:10]
-        rows = []
-        for c in self.controls:
-            if isinstance(c, Slider):
-                rows.append(
-                    f'<label style="display:inline-block;margin:0 1.2em 0.4em 0">{html.escape(c.label)} '
-                    f'<input type="range" data-param="{c.name}" min="{c.min}" max="{c.max}" step="{c.step}" '
-                    f'value="{c.value}" style="vertical-align:middle"> <output data-show="{c.name}">{c.value}'
-                    "</output></label>")
-            else:
-                opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
-                               f"{html.escape(lbl)}</option>" for v, lbl in c.options)
-                rows.append(f'<label style="display:inline-block;margin:0 1.2em 0.4em 0">{html.escape(c.label)} '
-                            f'<select data-param="{c.name}">{opts}</select></label>')
-        svgs = "".join(f'<svg data-plot="{p.id}" role="img" aria-label="{html.escape(p.ylabel)} over '
-                       f'{html.escape(p.xlabel)}" style="width:100%;max-width:640px;height:auto;display:block">'
-                       "</svg>" for p in self.plots)
         return (
             f'<div class="safepg-explorer" id="{uid}" style="border:1px solid rgba(127,127,127,.4);'
             f'border-radius:6px;padding:0.8em;margin:1em 0">'
             f'<div style="font-weight:600;margin-bottom:0.4em">{html.escape(self.title)}</div>'
-            f'{"".join(rows)}{svgs}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
+            f'{self._controls_html()}{self._plots_html()}'
+            '<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
             f"<script>(function(){{{LIB_JS}{_RUNTIME_JS}"
             f"const spec={spec};"
@@ -316,6 +323,11 @@ class Explorer:
     def _repr_html_(self) -> str:
         return self.to_html()
 
+    #: ``interactive()``: whether a slider redraws while it moves (False: on release, for a costly ``compute_py``).
+    continuous_update: ClassVar[bool] = True
+    #: ``interactive()``: width in inches of each plot.
+    plot_width: ClassVar[float] = 6.0
+
     def interactive(self) -> Any:
         """ipywidgets version for a live kernel: the same controls, drawn with matplotlib
         from ``compute_py``."""
@@ -325,14 +337,16 @@ class Explorer:
         kw: dict[str, Any] = {}
         for c in self.controls:
             if isinstance(c, Slider):
-                kw[c.name] = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label)
+                kw[c.name] = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label,
+                                           continuous_update=self.continuous_update)
             else:
                 kw[c.name] = w.Dropdown(options=[(lbl, v) for v, lbl in c.options], value=c.value,
                                         description=c.label)
 
         def draw(**p: Any) -> None:
             res = self.compute_py(p)
-            fig, axes = plt.subplots(1, len(self.plots), figsize=(6 * len(self.plots), 3.6), squeeze=False)
+            fig, axes = plt.subplots(1, len(self.plots), figsize=(self.plot_width * len(self.plots), 3.6),
+                                     squeeze=False)
             for ax, spec in zip(axes[0], self.plots):
                 r = res["plots"][spec.id]
                 for s in r["series"]:
@@ -346,7 +360,9 @@ class Explorer:
                 ax.set_ylabel(spec.ylabel)
                 if spec.ymin is not None or spec.ymax is not None:
                     ax.set_ylim(spec.ymin, spec.ymax)
-                ax.legend(fontsize="small")
+                if ax.get_legend_handles_labels()[1]:
+                    ax.legend(fontsize="small")
+            fig.tight_layout()
             plt.show()
             print(res.get("text", ""))
 

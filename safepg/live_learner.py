@@ -126,34 +126,22 @@ class LiveLearnerExplorer(Explorer):
     """An :class:`~safepg.explorer.Explorer` whose page runs the JavaScript learner in a
     Web Worker (see the module docstring); ``compute_js`` is unused."""
 
+    continuous_update = False  # interactive(): each change is a whole learning run, so sliders act on release
+    plot_width = 5.0
+
     def to_html(self) -> str:
         """The self-contained HTML + JavaScript block (learner, worker and plots inline)."""
         spec = json.dumps(self._spec(), separators=(",", ":"), allow_nan=False)
         learner = json.dumps(learner_js())
         # "safepg-" + 10 hex digits, as Explorer's ids: tests/nbval_sanitize.cfg masks them.
         uid = "safepg-" + hashlib.sha1((self.title + spec + learner).encode()).hexdigest()[:10]
-        rows = []
-        for c in self.controls:
-            style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
-            if isinstance(c, Slider):
-                rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
-                            f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
-                            f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')
-            else:
-                opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
-                               f"{html.escape(lbl)}</option>" for v, lbl in c.options)
-                rows.append(f'<label {style}>{html.escape(c.label)} <select data-param="{c.name}">{opts}</select>'
-                            "</label>")
-        svgs = "".join(f'<svg data-plot="{p.id}" role="img" aria-label="{html.escape(p.ylabel)} over '
-                       f'{html.escape(p.xlabel)}" style="width:100%;max-width:640px;height:auto;display:block">'
-                       "</svg>" for p in self.plots)
         return (
             f'<div class="safepg-explorer safepg-live" id="{uid}" style="border:1px solid rgba(127,127,127,.4);'
             f'border-radius:6px;padding:0.8em;margin:1em 0">'
             f'<div style="font-weight:600;margin-bottom:0.4em">{html.escape(self.title)}</div>'
-            f'{"".join(rows)}'
+            f'{self._controls_html()}'
             '<div class="safepg-status" style="font-size:0.85em;opacity:0.8;margin:0.2em 0"></div>'
-            f'{svgs}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
+            f'{self._plots_html()}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
             f"<script>(function(){{{_RUNTIME_JS}{_LIVE_JS}"
             f"const spec={spec};const learnerSrc={learner};"
@@ -162,41 +150,6 @@ class LiveLearnerExplorer(Explorer):
 
     def __repr__(self) -> str:
         return f"LiveLearnerExplorer({self.title!r})"
-
-    def interactive(self) -> Any:
-        """ipywidgets version for a live kernel: the same controls, each change reruns
-        :mod:`safepg.learning` (``compute_py``) and draws it with matplotlib. Sliders act
-        on release, since each change is a full learning run."""
-        import ipywidgets as w
-        import matplotlib.pyplot as plt
-
-        kw: dict[str, Any] = {}
-        for c in self.controls:
-            if isinstance(c, Slider):
-                kw[c.name] = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label,
-                                           continuous_update=False)
-            else:
-                kw[c.name] = w.Dropdown(options=[(lbl, v) for v, lbl in c.options], value=c.value,
-                                        description=c.label)
-
-        def draw(**p: Any) -> None:
-            res = self.compute_py(p)
-            fig, axes = plt.subplots(1, len(self.plots), figsize=(5 * len(self.plots), 3.6), squeeze=False)
-            for ax, spec in zip(axes[0], self.plots):
-                for s in res["plots"][spec.id]["series"]:
-                    ax.plot(s["x"], s["y"], color=s.get("color"), linestyle="--" if s.get("dash") else "-",
-                            label=s.get("label"))
-                ax.set_xscale("log" if spec.xlog else "linear")
-                ax.set_yscale("log" if spec.ylog else "linear")
-                ax.set_xlabel(spec.xlabel)
-                ax.set_ylabel(spec.ylabel)
-                if any(s.get("label") for s in res["plots"][spec.id]["series"]):
-                    ax.legend(fontsize="small")
-            fig.tight_layout()
-            plt.show()
-            print(res.get("text", ""))
-
-        return w.interactive(draw, **kw)
 
 
 # The page half. safepgPlot and safepgTicks come from safepg.explorer's runtime; the
