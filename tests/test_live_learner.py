@@ -105,3 +105,5 @@ def test_interactive_builds_widgets():
     assert calls and calls[0]["bound"] == "bernstein-er"
     names = {c.description for c in w.children[:-1]}
     assert {"delta", "sigma", "bound", "estimator", "baseline", "score", "seed"} <= names
+    sliders = [c for c in w.children if hasattr(c, "continuous_update") and hasattr(c, "step")]
+    assert sliders and not any(c.continuous_update for c in sliders)  # each move is a learning run: on release
