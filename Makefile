@@ -2,7 +2,7 @@
 PYTHON ?= python3
 PIP := $(PYTHON) -m pip
 
-.PHONY: setup browser-deps test test-lib book book-assets bench
+.PHONY: setup browser-deps lint test test-lib book book-assets bench
 
 setup:
 	$(PIP) install --quiet --disable-pip-version-check -r requirements.txt
@@ -13,7 +13,11 @@ setup:
 browser-deps:
 	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null)
 
-test: setup browser-deps
+# Lint (pyproject.toml's ruff rules) on the library, tests and benchmarks; notebooks are checked by nbval.
+lint: setup
+	$(PYTHON) -m ruff check safepg tests benchmarks
+
+test: setup browser-deps lint
 	$(PYTHON) -m pytest
 
 test-lib: setup

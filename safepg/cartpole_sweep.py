@@ -240,6 +240,7 @@ def sweep_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-__all__ = ["CAN_MOVE_C", "CAN_MOVE_SHARE", "LEARNS_MARGIN", "THESIS", "VANILLA_ALPHA", "baseline_experiments", "drawdown", "late_minus_early",
+__all__ = ["CAN_MOVE_C", "CAN_MOVE_SHARE", "LEARNS_MARGIN", "THESIS", "VANILLA_ALPHA", "baseline_experiments",
+           "drawdown", "late_minus_early",
            "load_sweep", "max_safe_step", "penalty_grid", "relative_move", "run_sweep", "smallest_c_by_gamma",
            "sweep_summary", "sweep_table"]

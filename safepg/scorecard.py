@@ -509,7 +509,8 @@ THEORY_LABELS = {
     "thm_4_3_2_upsilon_star": "Υ*", "thm_4_3_2_improvement": "guaranteed improvement N* Υ*",
     "hoeffding_exponent": "Hoeffding's tail", "range_definition": "range R of the gradient samples",
     "lemma_4_3_3_range": "bound on the range R", "algorithm_4_1_step_line": "Algorithm 4.1, step line",
-    "algorithm_4_1_stopping": "Algorithm 4.1, stopping test", "algorithm_4_1_min_batch": "Algorithm 4.1, smallest batch",
+    "algorithm_4_1_stopping": "Algorithm 4.1, stopping test",
+    "algorithm_4_1_min_batch": "Algorithm 4.1, smallest batch",
     "lemma_4_2_2_q_sign": "sign of the Q term", "thm_4_2_6_probability": "confidence (1 - δ)^m",
     "scalar_step_5_2_1": "scalar step α̂* as printed in 5.2.1",
 }
@@ -651,7 +652,8 @@ def _table_5_2_rows(b: _Builder, exp: Experiment, rep: Mapping[str, Any],
               difference="-" if mean is None else _signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
               page="lqg1d", heading="Table 5.2", note_id=note_id, explanation=explanation,
               thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-              expected_seeds=exp.seeds, fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
+              expected_seeds=exp.seeds,
+              fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
                       "delta": c.delta, "theoretical_range": c.theoretical_range,
                       "thesis_ci95": list(th["ci95"])})
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
@@ -780,7 +782,8 @@ def _upsilon_table_rows(b: _Builder, table: str, exp: Experiment, rep: Mapping[s
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
                   ok=None if mean is None else within_points(mean, th["improvement_ratio"]), rule="ratio-points",
                   page=page, heading=heading, thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci,
-                  seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "improvement_ratio"})
+                  seeds=r["seeds"], expected_seeds=exp.seeds,
+                  fields={"method": c.name, "quantity": "improvement_ratio"})
 
 
 def _table_5_3_extra_rows(b: _Builder, recs: Mapping[str, Sequence[LearningRecord]], seeds: int) -> None:
@@ -1053,7 +1056,8 @@ html[data-theme=dark] .sc-open{color:#ff8b82}
 """
 
 _STATUS_CLASS = {"reproduced": "sc-reproduced", "differs (explained)": "sc-explained", "open": "sc-open"}
-_HINT = "<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more columns).</p>"
+_HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
+         "columns).</p>")
 
 
 def _status_html(status: str) -> str:

@@ -361,7 +361,7 @@ def sweep_paths(plan: Sequence[tuple[Variant, float]] = CHAPTER_PLAN, seeds: int
     tasks.sort(key=lambda task: task[3])
     out = Parallel(n_jobs=jobs)(delayed(run_cell)(v, s, n, a, k, budget, t) for v, t, s, n, a, k in tasks)
     paths: dict[str, dict[str, dict[str, list[list[float]]]]] = {}
-    for (v, t, s, n, a, k), pth in sorted(zip(tasks, out), key=lambda x: x[0][-1]):
+    for (v, t, s, n, a, _k), pth in sorted(zip(tasks, out), key=lambda x: x[0][-1]):
         paths.setdefault(v.label, {}).setdefault(_theta0_key(t), {}).setdefault(cell_name(s, n, a), []).append(pth)
     result = {"plan": spec, "seeds": seeds, "budget": budget, "paths": paths}
     path.parent.mkdir(parents=True, exist_ok=True)

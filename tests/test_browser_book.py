@@ -236,7 +236,8 @@ def _explorer_axes(pg: OfflinePage) -> list[str]:
       document.querySelectorAll('.safepg-explorer svg[data-plot]').forEach((svg, k) => {
         if (!svg.querySelector('path.safepg-series')) return;  // "no data for this choice"
         const S = svg.getBoundingClientRect();
-        const ticks = [...svg.querySelectorAll('text.safepg-tick')].map(t => ({t: t.textContent, r: t.getBoundingClientRect()}));
+        const ticks = [...svg.querySelectorAll('text.safepg-tick')]
+          .map(t => ({t: t.textContent, r: t.getBoundingClientRect()}));
         if (ticks.length < 2) { bad.push(`plot ${k}: ${ticks.length} tick labels`); return; }
         for (const a of ticks) {
           if (a.r.left < S.left - 1 || a.r.right > S.right + 1 || a.r.top < S.top - 1 || a.r.bottom > S.bottom + 1)

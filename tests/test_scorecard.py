@@ -251,7 +251,8 @@ def test_every_row_links_to_a_section_of_the_book(rows):
 def test_links_follow_headings(tmp_path):
     import nbformat
 
-    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell("# Chapter: Table 5.9\n\n## Table 5.9 and $\\alpha$")])
+    cell = nbformat.v4.new_markdown_cell("# Chapter: Table 5.9\n\n## Table 5.9 and $\\alpha$")
+    nb = nbformat.v4.new_notebook(cells=[cell])
     nbformat.write(nb, tmp_path / "page.ipynb")
     assert sc.book_link("page", "Table 5.9", tmp_path) == "page.html#table-5-9-and-alpha"  # section over title
     assert sc.book_link("page", "Chapter", tmp_path) == "page.html#chapter-table-5-9"

@@ -26,8 +26,6 @@ so the result does not depend on the number of threads.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 

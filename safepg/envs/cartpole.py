@@ -386,7 +386,8 @@ class CartPole:
         Returns
         -------
         Trajectories
-            features = states (or their normalisation, see ``feature_scale``), actions_raw = sampled forces, actions = clipped forces,
+            features = states (or their normalisation, see ``feature_scale``), actions_raw = sampled forces,
+            actions = clipped forces,
             rewards = 1 while alive, mask = alive; zeros at dead steps.
         """
         n = self._check_policy_and_n(policy, n)
