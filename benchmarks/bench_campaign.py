@@ -1,6 +1,6 @@
 """Wall time of Chapter 5's experiments at the thesis's scale, from an empty cache.
 
-Runs each named experiment (default: every one in ``safepg.experiments``) into a fresh
+Runs each named experiment (default: every one in ``safepg.thesis.experiments``) into a fresh
 results folder with all cores, then reruns it to time the cached path, and merges the
 timings into ``benchmarks/campaign_timings.json`` (which the chapters quote).
 
@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from safepg.experiments import EXPERIMENTS, report, run_experiment
+from safepg.thesis.experiments import EXPERIMENTS, report, run_experiment
 
 TIMINGS = Path(__file__).with_name("campaign_timings.json")
 

@@ -1,4 +1,4 @@
-"""Speed of the page's JavaScript learner (safepg/static/learner.js) against safepg's numba kernel.
+"""Speed of the page's JavaScript learner (safepg/thesis/explorers/static/learner.js) against safepg's numba kernel.
 
 Measures, on one core:
 
@@ -9,7 +9,7 @@ Measures, on one core:
   Bernstein with the empirical range, delta = 0.95, sigma = 1), both implementations.
 
 - the same run in headless Chromium (Debian's, through Playwright): the explorer page of
-  ``safepg.live_learner`` with vanilla PG off, time inside the Web Worker's learner and
+  ``safepg.thesis.explorers.live_learner`` with vanilla PG off, time inside the Web Worker's learner and
   the page's time from the control move to the last curve (worker start, messages and
   drawing included), and the CPU time all of Chromium's processes used meanwhile, for a
   few seeds.
@@ -84,7 +84,7 @@ def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
         return None
     import psutil
 
-    from safepg.live_learner import live_batch_size_explorer
+    from safepg.thesis.explorers.live_learner import live_batch_size_explorer
 
     def browser_cpu() -> float:
         """CPU seconds used so far by this process's Chromium processes (all of them: an

@@ -105,7 +105,7 @@ def _run_learn(args: argparse.Namespace) -> dict:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from safepg import experiments  # imported here: ``learn`` alone needs none of the runner
+    from safepg.thesis import experiments  # imported here: ``learn`` alone needs none of the runner
 
     parser = argparse.ArgumentParser(prog="safepg", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)

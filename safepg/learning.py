@@ -18,7 +18,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from safepg import portable
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
 from safepg.constants import BoundedTask, TaskConstants
 from safepg.estimators import Estimator, ScoreAction, gradient_samples

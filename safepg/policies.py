@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from safepg import portable
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 
 
 def _check_sigma(sigma: float | np.ndarray, action_dim: int) -> np.ndarray:

@@ -623,7 +623,7 @@ def gradient_range_bound() -> dict[str, sp.Expr]:
     bounded that way. With :math:`|\theta^T\varphi(s)| \le \bar\mu`,
     :math:`|a - \mu| \le \bar A + \bar\mu`, so a sample is at most ``sup_abs_bound`` in
     magnitude and its range at most ``worst_case_range`` (twice that); the
-    construction in :func:`safepg.lemma_checks.check_lemma_4_3_3` attains it.
+    construction in :func:`safepg.thesis.lemma_checks.check_lemma_4_3_3` attains it.
     ``worst_case_over_printed`` :math:`=(1-\gamma^H)(1+\bar\mu/\bar A)` exceeds 1 e.g. for
     :math:`H = 20, \gamma = 0.9, \bar\mu > 0.14\bar A`.
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from safepg.analysis import (
+from safepg.thesis.analysis import (
     by_iteration,
     markdown_table,
     mean_band,
@@ -48,7 +48,7 @@ def test_table_5_2_differences():
 
 def test_simulated_gradient_matches_settings_value():
     # SETTINGS.md: at theta = -0.3 the finite difference of the simulated return is about -3.870.
-    from safepg.analysis import simulated_gradient, simulated_performance
+    from safepg.thesis.analysis import simulated_gradient, simulated_performance
     from safepg.envs.lqg import LQG
 
     env = LQG.thesis_1d()
@@ -58,7 +58,7 @@ def test_simulated_gradient_matches_settings_value():
 
 
 def test_gradient_estimates_share_batches_and_concentrate():
-    from safepg.analysis import gradient_estimates
+    from safepg.thesis.analysis import gradient_estimates
     from safepg.envs.lqg import LQG
 
     est = gradient_estimates(LQG.thesis_1d(), -0.3, 1.0, [100, 10_000], repeats=20, seed=0)
@@ -69,7 +69,7 @@ def test_gradient_estimates_share_batches_and_concentrate():
 
 
 def test_improvement_ratio_on_other_objective():
-    from safepg.analysis import improvement_ratio_on
+    from safepg.thesis.analysis import improvement_ratio_on
 
     r = rec([1, 1, 1], [0, 0, 0, 0])
     r.theta[:, 0] = [0.0, 0.1, 0.05, 0.2]
@@ -79,7 +79,7 @@ def test_improvement_ratio_on_other_objective():
 
 def test_simulated_objective_optimum_differs_from_closed_form():
     # SETTINGS.md: the clipped 20-step objective peaks near theta = -0.65 (J ~ -9.56), not -0.588.
-    from safepg.analysis import simulated_objective
+    from safepg.thesis.analysis import simulated_objective
     from safepg.envs.lqg import LQG
 
     f = simulated_objective(LQG.thesis_1d(), 1.0, -0.9, -0.4, points=26, n=100_000, seed=3)
@@ -113,7 +113,7 @@ def test_comparison_figures_draw_the_seed_means():
     import matplotlib
 
     matplotlib.use("Agg")
-    from safepg.figures import figure_5_6, figure_comparison
+    from safepg.thesis.figures import figure_5_6, figure_comparison
 
     recs = {"a": [rec([10, 20], [-5.0, -4.0, -3.0])], "b": [rec([30], [-6.0, -1.0])]}
     fig = figure_comparison(recs, {"a": "A", "b": "B"}, measured=True)

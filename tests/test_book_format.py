@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import sympy as sp  # noqa: E402
 
-from safepg.analysis import errata_markdown, markdown_table, with_labels  # noqa: E402
+from safepg.thesis.analysis import errata_markdown, markdown_table, with_labels  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -101,7 +101,7 @@ def test_renumbering_overrides_sphinx_counts():
 def test_figure_4_1_tick_labels_do_not_overlap():
     """The symmetric-log axis of Figure 4.1 used to print crowded labels around 0."""
     from safepg.bounds import ErrorBound
-    from safepg.figures import figure_4_1
+    from safepg.thesis.figures import figure_4_1
 
     fig = figure_4_1(3.5, ErrorBound(11.3, 357.0), 9753.0)
     fig.canvas.draw()
@@ -122,7 +122,7 @@ def test_figure_4_1_tick_labels_do_not_overlap():
 
 def test_preliminaries_figures_have_no_titles():
     from safepg.envs.lqg import LQG
-    from safepg.figures import figure_estimator_variance, figure_gradient_estimates, figure_lqg_performance
+    from safepg.thesis.figures import figure_estimator_variance, figure_gradient_estimates, figure_lqg_performance
 
     env = LQG.thesis_1d()
     ns = [10, 100]

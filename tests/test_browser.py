@@ -41,7 +41,7 @@ def test_intro_renders(browser, book):
 
 
 def test_lqg_explorer_matches_safepg(browser, book):
-    from safepg.explorers import lqg_explorer
+    from safepg.thesis.explorers.curves import lqg_explorer
 
     pg = OfflinePage(browser, book / "book" / "preliminaries.html", height=1600)
     _check_page(pg, min_images=3)
@@ -75,7 +75,7 @@ def _set(page, name: str, value: str) -> None:
 
 
 def test_upsilon_explorer_matches_safepg(browser, book):
-    from safepg.explorers import upsilon_explorer
+    from safepg.thesis.explorers.curves import upsilon_explorer
 
     pg = OfflinePage(browser, book / "book" / "adaptive_batch.html", height=1600)
     _check_page(pg, min_images=1)
@@ -103,8 +103,8 @@ def test_batch_size_explorer_matches_stored_runs(browser, book):
     (tests/test_browser_learner.py drives every control on a page of its own)."""
     import json
 
-    from safepg.experiments import get_experiment, load_experiment
-    from safepg.live_learner import TITLE, live_batch_size_explorer
+    from safepg.thesis.experiments import get_experiment, load_experiment
+    from safepg.thesis.explorers.live_learner import TITLE, live_batch_size_explorer
 
     pg = OfflinePage(browser, book / "book" / "lqg1d.html", height=1600)
     _check_page(pg, min_images=4)

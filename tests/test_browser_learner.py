@@ -28,7 +28,7 @@ MAX_RUN_SECONDS = 20.0
 
 def stored_runs(budget: int = 3_000_000, seeds: int = 1) -> tuple[dict[str, list[Any]], list[Any]]:
     """A Table 5.2 configuration run for the overlay (few seeds, up to the largest budget)."""
-    from safepg.experiments import get_experiment, t52_name
+    from safepg.thesis.experiments import get_experiment, t52_name
 
     exp = get_experiment("table-5.2")
     configs = [replace(exp.config(t52_name(*k)), budget=budget)
@@ -38,7 +38,7 @@ def stored_runs(budget: int = 3_000_000, seeds: int = 1) -> tuple[dict[str, list
 
 @pytest.fixture(scope="module")
 def explorer_page(tmp_path_factory) -> tuple[Path, Any]:
-    from safepg.live_learner import live_batch_size_explorer
+    from safepg.thesis.explorers.live_learner import live_batch_size_explorer
 
     records, configs = stored_runs()
     explorer = live_batch_size_explorer(records, configs)

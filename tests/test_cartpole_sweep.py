@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from safepg.cartpole_sweep import (
+from safepg.thesis.cartpole_sweep import (
     CAN_MOVE_SHARE,
     LEARNS_MARGIN,
     THESIS,
@@ -25,7 +25,7 @@ from safepg.cartpole_sweep import (
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import NORMALISED_SCALE, CartPole
 from safepg.estimators import gradient_samples
-from safepg.experiments import CARTPOLE_SWEEP, EXPERIMENTS, SWEEP_BUDGET, get_experiment, make_env
+from safepg.thesis.experiments import CARTPOLE_SWEEP, EXPERIMENTS, SWEEP_BUDGET, get_experiment, make_env
 from safepg.learning import LearningRecord
 from safepg.meta import penalty_constant
 from safepg.policies import LinearGaussianPolicy

@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from safepg import experiments as ex
+from safepg.thesis import experiments as ex
 from safepg.cli import main
 
 
@@ -145,7 +145,7 @@ def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
     # A cheap stand-in for the baseline: the same experiment name, two iterations.
     cheap = replace(base, configs=(replace(base.configs[0], budget=8000, target_return=None),))
     t54 = ex.scaled(ex.get_experiment("table-5.4"), seeds=2, budget=12_000)
-    import safepg.experiments as mod
+    import safepg.thesis.experiments as mod
 
     saved = dict(mod.EXPERIMENTS)
     mod.EXPERIMENTS["cartpole-baseline"] = cheap

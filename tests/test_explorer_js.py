@@ -25,7 +25,7 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.explorer import LIB_JS
+from safepg.thesis.explorers.component import LIB_JS
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,

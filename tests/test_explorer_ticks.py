@@ -1,4 +1,4 @@
-"""The explorers' axis ticks (``safepgTicks``, ``safepgTickLabels`` in safepg/explorer.py),
+"""The explorers' axis ticks (``safepgTicks``, ``safepgTickLabels`` in safepg/thesis/explorers/component.py),
 evaluated with Node.js: every label distinct, and as short as that allows.
 
 The browser test (test_browser_book.py) checks the drawn labels stay inside each plot.
@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from safepg.explorer import _RUNTIME_JS
+from safepg.thesis.explorers.component import _RUNTIME_JS
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from safepg.envs.lqg import LQG
-from safepg.lqg_settings import (
+from safepg.thesis.lqg_settings import (
     PRINTED_J_STAR,
     lab_performance_at_states,
     lab_performance_moments,

@@ -1,4 +1,4 @@
-"""The JavaScript learner of the live explorer (safepg/static/learner.js) against safepg, under Node.js.
+"""The JavaScript learner of the live explorer (safepg/thesis/explorers/static/learner.js) against safepg, under Node.js.
 
 Deterministic parts: given the same inputs (gradient-sample arrays, random numbers), the
 JavaScript and Python implementations give the same bounds (d, f, eps), N*, step and
@@ -36,7 +36,7 @@ from safepg.bounds import (
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg
-from safepg.live_learner import task_data
+from safepg.thesis.explorers.live_learner import task_data
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
 
 NODE = shutil.which("node")

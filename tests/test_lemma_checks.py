@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from safepg import lemma_checks as L
+from safepg.thesis import lemma_checks as L
 
 
 def test_gaussian_second_derivative_shape_sup():

@@ -1,4 +1,4 @@
-"""The live batch-size explorer's Python side (safepg/live_learner.py): the page it renders,
+"""The live batch-size explorer's Python side (safepg/thesis/explorers/live_learner.py): the page it renders,
 the stored runs it embeds and its Python twin. The JavaScript learner itself is tested
 against safepg in tests/test_learner_js.py, the page in tests/test_browser_learner.py."""
 
@@ -11,9 +11,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from safepg.experiments import get_experiment, t52_name
+from safepg.thesis.experiments import get_experiment, t52_name
 from safepg.learning import LearningRecord
-from safepg.live_learner import BUDGETS, learner_js, live_batch_size_explorer, task_data
+from safepg.thesis.explorers.live_learner import BUDGETS, learner_js, live_batch_size_explorer, task_data
 
 
 def fake_record(batch_sizes: list[int], seed: int) -> LearningRecord:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from safepg.envs.lqg import LQG
-from safepg.lqg_settings import (
+from safepg.thesis.lqg_settings import (
     FIXED_POINTS,
     PRINTED_J_STAR,
     SettingsGrid,

@@ -14,7 +14,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from safepg import experiments as ex
+from safepg.thesis import experiments as ex
 from safepg.cli import main
 from safepg.learning import LearningRecord
 

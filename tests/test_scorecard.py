@@ -1,4 +1,4 @@
-"""The reproduction scorecard (safepg.scorecard): tolerances, completeness, statuses, export.
+"""The reproduction scorecard (safepg.thesis.scorecard): tolerances, completeness, statuses, export.
 
 The rows are built from a tiny store: every experiment the scorecard reads, scaled to 2
 seeds and a few thousand trajectories (the cart-pole runs start from theta = 0 instead of
@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from safepg import scorecard as sc
+from safepg.thesis import scorecard as sc
 from safepg import theory
-from safepg.experiments import get_experiment, scaled
+from safepg.thesis.experiments import get_experiment, scaled
 
 BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2d", "cartpole", "errata"}
 

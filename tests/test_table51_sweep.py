@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from safepg import table51_sweep as ts
+from safepg.thesis import table51_sweep as ts
 from safepg.envs.lqg import LQG
 from safepg.estimators import trajectory_scores
-from safepg.experiments import _T51_PRINTED
+from safepg.thesis.experiments import _T51_PRINTED
 from safepg.policies import LinearGaussianPolicy
 
 ENV = LQG.thesis_1d()
@@ -163,7 +163,7 @@ def test_fixed_step_run_is_the_library_vanilla_loop(baseline, flag):
 
 
 def test_sweep_starts_are_the_experiments_starts():
-    from safepg import experiments as ex
+    from safepg.thesis import experiments as ex
 
     assert ts.PRINTED_THETA0 == ex.T51_PRINTED_THETA0 and ts.RECONSTRUCTED_THETA0 == ex.T51_THETA0
     assert ts.PRINTED_THETA0 in ts.THETA0_SCAN and ts.RECONSTRUCTED_THETA0 in ts.THETA0_SCAN

@@ -8,7 +8,7 @@ import pytest
 from safepg.bounds import error_bound
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.experiments import RECONSTRUCTED_RANGE, get_experiment
+from safepg.thesis.experiments import RECONSTRUCTED_RANGE, get_experiment
 
 THEORETICAL_ROWS = {"gpomdp-hoeffding-delta=0.95", "gpomdp-bernstein-delta=0.95"}
 

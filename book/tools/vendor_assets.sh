@@ -7,7 +7,7 @@
 # (about 1.7 MB), which would be committed vendor code with its own licence to track;
 # the pinned version plus checksum makes the fetch as reproducible as a commit.
 # Why MathJax only: the explorers are plain text/html with inline JavaScript (see
-# safepg/explorer.py), so the pages need neither require.js nor the ipywidgets HTML
+# safepg/thesis/explorers/component.py), so the pages need neither require.js nor the ipywidgets HTML
 # manager; book/_ext/no_widgets.py fails the build if a widget output ever appears.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"

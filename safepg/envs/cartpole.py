@@ -59,7 +59,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from safepg import portable
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 from safepg.constants import HORIZON_TERMS
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
@@ -381,7 +381,7 @@ class CartPole:
         n : int
             Number of trajectories (>= 1).
         rng : Generator, int or None
-            Random source (see :func:`safepg._rng.as_generator`).
+            Random source (see :func:`safepg.rng.as_generator`).
 
         Returns
         -------
@@ -464,7 +464,7 @@ class CartPole:
         n : int
             Number of trajectories (>= 1).
         rng : Generator, int or None
-            Random source (see :func:`safepg._rng.as_generator`).
+            Random source (see :func:`safepg.rng.as_generator`).
         estimator : {"gpomdp", "reinforce"}
             Likelihood-ratio estimator (discounted with ``gamma``).
         baseline : bool

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from safepg import portable
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, _check_sigma
 from safepg.trajectories import Trajectories

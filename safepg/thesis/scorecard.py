@@ -3,11 +3,11 @@ r"""The reproduction scorecard: every quantitative result the thesis prints, our
 One :class:`Row` per printed result, built from the same sources the chapters use:
 
 * the stored runs of the Chapter 5 experiments, summarised by
-  :func:`safepg.experiments.report` (every cell of Tables 5.1-5.4, the improvement ratios,
+  :func:`safepg.thesis.experiments.report` (every cell of Tables 5.1-5.4, the improvement ratios,
   the final parameters of Section 5.2.1, the cart-pole baseline's iteration count), with
-  the printed values taken from each :class:`~safepg.experiments.Experiment`'s ``thesis``;
+  the printed values taken from each :class:`~safepg.thesis.experiments.Experiment`'s ``thesis``;
 * the closed forms of :class:`safepg.envs.lqg.LQG` (:math:`\theta^*`, :math:`J(\theta^*)`)
-  with the printed values of :mod:`safepg.lqg_settings` and :data:`PRINTED`;
+  with the printed values of :mod:`safepg.thesis.lqg_settings` and :data:`PRINTED`;
 * the printed statements of Chapters 3-4 and the appendices against their sympy
   derivations, as recorded by :func:`safepg.theory.verified` and
   :func:`safepg.theory.errata`.
@@ -40,7 +40,7 @@ import sympy as sp
 
 from safepg import theory
 from safepg.envs.lqg import LQG
-from safepg.experiments import (
+from safepg.thesis.experiments import (
     EXPERIMENTS,
     LQG2D_GAMMA,
     T51_PRINTED_THETA0,
@@ -51,7 +51,7 @@ from safepg.experiments import (
     run_experiment,
 )
 from safepg.learning import LearningRecord
-from safepg.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
+from safepg.thesis.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
 
 Status = Literal["reproduced", "differs (explained)", "open"]
 #: The statuses, in the order the page lists them.
@@ -61,7 +61,7 @@ STATUSES: tuple[Status, ...] = ("reproduced", "differs (explained)", "open")
 GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5.2", "Section 5.3")
 
 #: Printed values that no other module records (the others come from the experiments'
-#: ``thesis`` dicts, :mod:`safepg.lqg_settings` and :mod:`safepg.theory`). Strings keep the
+#: ``thesis`` dicts, :mod:`safepg.thesis.lqg_settings` and :mod:`safepg.theory`). Strings keep the
 #: printed digits, which set the rounding tolerance.
 PRINTED: dict[str, Any] = {
     # Section 5.1: "theta* ~ -0.59, corresponding to expected performance J(theta*) ~ -13.21".
@@ -870,12 +870,12 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     root : Path, optional
         Results store (default ``$SAFEPG_RESULTS`` or ``results/``).
     run : bool
-        Compute the missing runs first (:func:`~safepg.experiments.run_experiment`); with
+        Compute the missing runs first (:func:`~safepg.thesis.experiments.run_experiment`); with
         ``False`` only stored runs are read, and rows without runs are ``"open"``.
     experiments : mapping, optional
         Replacements for the experiments of :data:`NEEDED` (and the variants
         :data:`RANGE_VARIANTS`, :data:`THETA0_VARIANTS`) by
-        name, e.g. :func:`~safepg.experiments.scaled` copies for a quick look or a test.
+        name, e.g. :func:`~safepg.thesis.experiments.scaled` copies for a quick look or a test.
     jobs : int
         Parallel jobs when ``run`` (joblib's convention).
     book : Path, optional

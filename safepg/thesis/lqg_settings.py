@@ -38,7 +38,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from safepg import portable
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 from safepg.envs.lqg import LQG
 from safepg.policies import LinearGaussianPolicy, _check_sigma
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from scipy import integrate
 
-from safepg._rng import RNGLike, as_generator
+from safepg.rng import RNGLike, as_generator
 from safepg.estimators import check_estimator
 
 __all__ = [

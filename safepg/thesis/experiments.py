@@ -120,7 +120,7 @@ class RunConfig:
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
 #: of the printed 0.95, the discount that reproduces the printed theta*, final parameters and
-#: Table 5.3 (see :mod:`safepg.lqg_settings` and the chapter).
+#: Table 5.3 (see :mod:`safepg.thesis.lqg_settings` and the chapter).
 LQG2D_GAMMA = 0.9
 
 
@@ -183,7 +183,7 @@ _T51_PRINTED = {
 T51_PRINTED_THETA0 = -0.55
 #: Starting point Table 5.1 is run from: our reconstruction, not printed. With it all 24 cells
 #: come within 2 points of the printed ratios at once (from the printed -0.55, 9 cells are
-#: 5-40 points off); the sweep of safepg.table51_sweep shows that no other unstated setting
+#: 5-40 points off); the sweep of safepg.thesis.table51_sweep shows that no other unstated setting
 #: (baseline, score, sigma reading, J formula, counting) does this from -0.55, and that
 #: -0.57 and -0.58 are already clearly worse.
 T51_THETA0 = -0.575
@@ -344,7 +344,7 @@ def _table_5_4() -> Experiment:
 
 
 # The cart-pole sweep (issue 13): which unstated settings let the adaptive step move on the
-# doubled pole? :mod:`safepg.cartpole_sweep` computes the penalty constant over the whole grid
+# doubled pole? :mod:`safepg.thesis.cartpole_sweep` computes the penalty constant over the whole grid
 # of settings analytically and reads these runs back for the chapter.
 
 #: Trajectories per doubled-pole run of the sweep (both methods: 50 iterations of the

@@ -65,7 +65,7 @@ def estimator_color(estimator: str) -> str:
 
 def style_table() -> dict[str, Any]:
     """Every colour, label and dash of this module as JSON-ready data, for the browser
-    explorers (``safepg.explorer``), so JavaScript and matplotlib draw alike.
+    explorers (``safepg.thesis.explorers.component``), so JavaScript and matplotlib draw alike.
 
     Returns
     -------

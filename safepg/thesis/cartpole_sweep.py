@@ -13,7 +13,7 @@ depends on settings the thesis does not state. This module
 - computes c and the largest safe step :math:`1/(2c)` over the whole grid of plausible
   settings analytically (:func:`penalty_grid`, free);
 - runs the short learning runs of ``cartpole-sweep`` and the baseline searches
-  ``cartpole-baseline-*`` (defined in :mod:`safepg.experiments`, stored like every other
+  ``cartpole-baseline-*`` (defined in :mod:`safepg.thesis.experiments`, stored like every other
   experiment, :func:`run_sweep`);
 - summarises them per setting (:func:`sweep_table`): whether the adaptive method learns,
   Upsilon-bar and improvement ratio of both methods, the baseline's iteration count, and
@@ -32,7 +32,7 @@ import numpy as np
 from safepg import portable
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
-from safepg.experiments import (
+from safepg.thesis.experiments import (
     CARTPOLE_SWEEP,
     SWEEP_BUDGET,
     SWEEP_SEEDS,
@@ -121,9 +121,9 @@ def baseline_experiments() -> list[str]:
 def run_sweep(root: Path | None = None, jobs: int = -1, progress: bool = False) -> dict[str, Any]:
     """Run (or load) every run of the sweep: the baseline searches, then ``cartpole-sweep``.
 
-    Each is an ordinary experiment of :mod:`safepg.experiments`, stored under ``root``
+    Each is an ordinary experiment of :mod:`safepg.thesis.experiments`, stored under ``root``
     (``python -m safepg run cartpole-sweep`` does the same from the shell). The baselines
-    run with :data:`~safepg.experiments.SWEEP_SEEDS` seeds. Returns
+    run with :data:`~safepg.thesis.experiments.SWEEP_SEEDS` seeds. Returns
     ``{"baselines": {experiment: records}, "sweep": records by config}``.
     """
     baselines = {}

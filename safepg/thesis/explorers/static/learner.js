@@ -1,7 +1,7 @@
 /*
  * safepg's learner in plain JavaScript: Algorithm 4.1 (adaptive step and batch size) and
  * vanilla policy gradient on the one-dimensional LQG of Section 5.1, for the book's
- * kernel-free batch-size explorer (safepg/live_learner.py runs it in a Web Worker).
+ * kernel-free batch-size explorer (safepg/thesis/explorers/live_learner.py runs it in a Web Worker).
  *
  * It is the same algorithm as safepg.learning.adaptive_pg / vanilla_pg on LQG.thesis_1d():
  *   - simulation and gradient samples as safepg.envs._lqg_kernel.lqg1d_gradient_samples

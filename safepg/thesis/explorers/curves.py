@@ -1,9 +1,9 @@
-"""The book's explorers, built on :class:`safepg.explorer.Explorer`.
+"""The book's explorers, built on :class:`safepg.thesis.explorers.component.Explorer`.
 
 Each factory returns an explorer whose JavaScript and Python halves compute the same
 curves: closed forms in both, precomputed Monte Carlo quantities embedded as data.
 The batch-size explorer, which reruns Algorithm 4.1 in the page, is
-:func:`safepg.live_learner.live_batch_size_explorer`.
+:func:`safepg.thesis.explorers.live_learner.live_batch_size_explorer`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from safepg import plotting
+from safepg.thesis import plotting
 from safepg.bounds import (
     ErrorBound,
     bernstein,
@@ -25,7 +25,7 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.explorer import Explorer, Plot, Select, Slider
+from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -63,7 +63,7 @@ def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_v
     """1-D LQG: the closed-form J(theta) as sigma moves (theta* marked), beside the
     per-trajectory variance of the REINFORCE and G(PO)MDP samples (Monte Carlo,
     precomputed on a sigma grid)."""
-    from safepg.analysis import sample_variance
+    from safepg.thesis.analysis import sample_variance
 
     env = LQG.thesis_1d()
     sigmas = np.round(np.linspace(0.2, 2.0, 19), 3) if sigmas is None else np.asarray(sigmas)

@@ -1,7 +1,7 @@
 """One function per figure of the thesis, redrawn from stored results.
 
 Each function takes the records (or the quantities) it draws and returns the matplotlib
-Figure; the numbers behind every curve come from :mod:`safepg.analysis`.
+Figure; the numbers behind every curve come from :mod:`safepg.thesis.analysis`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from safepg import plotting
-from safepg.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
+from safepg.thesis import plotting
+from safepg.thesis.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
 from safepg.bounds import ErrorBound
 from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
@@ -217,7 +217,7 @@ def figure_estimator_variance(sigmas: np.ndarray, variance: Mapping[str, np.ndar
 def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) -> Figure:
     """Cart-pole sweep (ours, issue 13): Upsilon-bar and improvement ratio of both methods per setting.
 
-    ``rows`` are :func:`safepg.cartpole_sweep.sweep_table` rows (settings without a doubled-pole
+    ``rows`` are :func:`safepg.thesis.cartpole_sweep.sweep_table` rows (settings without a doubled-pole
     run are skipped), one per line from the top, labelled with the setting's penalty constant c;
     ``thesis`` holds its ``THESIS`` values, drawn as dashed lines. Filled adaptive markers: the
     adaptive method learns under that setting; open: it does not. Counterfactual settings (not
@@ -261,7 +261,7 @@ def figure_penalty_grid(rows: Sequence[Mapping], threshold_c: float | None = Non
                         ours: tuple[float, float] | None = None) -> Figure:
     """Cart-pole sweep (ours, issue 13): the penalty constant c against gamma, analytically.
 
-    ``rows`` are :func:`safepg.cartpole_sweep.penalty_grid` rows. For each horizon term, the
+    ``rows`` are :func:`safepg.thesis.cartpole_sweep.penalty_grid` rows. For each horizon term, the
     band spans every (M_phi, |A|) of the grid with R = 1; the line is its most favourable
     corner (smallest c). The right axis is the largest safe step 1/(2c); ``threshold_c``
     (dotted) is where that step becomes able to move theta; ``ours`` = (gamma, c) is starred.

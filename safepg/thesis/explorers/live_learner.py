@@ -1,7 +1,7 @@
 r"""The live batch-size explorer: Algorithm 4.1 reruns in the reader's browser.
 
-:func:`live_batch_size_explorer` returns an :class:`~safepg.explorer.Explorer` whose page
-half runs the JavaScript learner ``safepg/static/learner.js`` (Algorithm 4.1 and vanilla
+:func:`live_batch_size_explorer` returns an :class:`~safepg.thesis.explorers.component.Explorer` whose page
+half runs the JavaScript learner ``safepg/thesis/explorers/static/learner.js`` (Algorithm 4.1 and vanilla
 policy gradient on ``LQG.thesis_1d()``, the same algorithm as :mod:`safepg.learning`) in
 a Web Worker created from an inline Blob, so it needs no kernel, no network and no file
 beside the page (it works from ``file://``). Every control move cancels the running
@@ -31,10 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from safepg import plotting, portable
-from safepg.analysis import by_iteration, mean_band, performance_on_grid
+from safepg import portable
+from safepg.thesis import plotting
+from safepg.thesis.analysis import by_iteration, mean_band, performance_on_grid
 from safepg.envs.lqg import LQG
-from safepg.explorer import _RUNTIME_JS, Explorer, Plot, Select, Slider
+from safepg.thesis.explorers.component import _RUNTIME_JS, Explorer, Plot, Select, Slider
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
@@ -51,7 +52,7 @@ TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in you
 
 @lru_cache(maxsize=1)
 def learner_js() -> str:
-    """The JavaScript learner shipped in the package (``safepg/static/learner.js``)."""
+    """The JavaScript learner shipped in the package (``safepg/thesis/explorers/static/learner.js``)."""
     return resources.files("safepg").joinpath("static/learner.js").read_text(encoding="utf-8")
 
 
@@ -123,7 +124,7 @@ def overlay_key(p: Mapping[str, Any]) -> str:
 
 
 class LiveLearnerExplorer(Explorer):
-    """An :class:`~safepg.explorer.Explorer` whose page runs the JavaScript learner in a
+    """An :class:`~safepg.thesis.explorers.component.Explorer` whose page runs the JavaScript learner in a
     Web Worker (see the module docstring); ``compute_js`` is unused."""
 
     continuous_update = False  # interactive(): each change is a whole learning run, so sliders act on release
@@ -152,7 +153,7 @@ class LiveLearnerExplorer(Explorer):
         return f"LiveLearnerExplorer({self.title!r})"
 
 
-# The page half. safepgPlot and safepgTicks come from safepg.explorer's runtime; the
+# The page half. safepgPlot and safepgTicks come from safepg.thesis.explorers.component's runtime; the
 # learner source is a string so the worker can be built from a Blob (no file, no network).
 _LIVE_JS = r"""
 const SAFEPG_WORKER_GLUE = `
@@ -361,7 +362,7 @@ def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | N
     Parameters
     ----------
     records : stored runs by configuration name (e.g. ``run_experiment("table-5.2")``), or None
-    configs : the :class:`~safepg.experiments.RunConfig` of those runs; those that the
+    configs : the :class:`~safepg.thesis.experiments.RunConfig` of those runs; those that the
         learner can rerun (Algorithm 4.1, 1-D LQG, theta_0 = 0, sigma = 1, baseline on)
         are embedded as overlays, their seed means rounded to 6 significant digits
     points : trajectory counts at which the stored J curves are embedded (log-spaced up

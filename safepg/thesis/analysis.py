@@ -171,7 +171,7 @@ def with_labels(rows: Sequence[dict[str, Any]], suffix: str = "") -> list[dict[s
     """Copies of table rows whose ``estimator`` and ``bound`` (with ``empirical_range``)
     hold the labels the figures use, e.g. ``"G(PO)MDP"`` and ``"Hoeffding (e.r.)"``;
     ``suffix`` is appended to the bound label (e.g. ``", range 1280"``)."""
-    from safepg import plotting  # matplotlib only when a table is labelled
+    from safepg.thesis import plotting  # matplotlib only when a table is labelled
 
     out = []
     for r in rows:

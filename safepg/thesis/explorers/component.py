@@ -117,7 +117,7 @@ function safepgTickLabels(ticks, log) {
   return ticks.map(String);
 }
 function safepgPlot(svg, spec, res) {
-  // A small SVG line plot. Colours: series colours from safepg.plotting, everything else
+  // A small SVG line plot. Colours: series colours from safepg.thesis.plotting, everything else
   // currentColor, so the plot follows the page's light or dark theme.
   const W = 640, Hh = 320, m = {l: 62, r: 12, t: 12, b: 40};
   const NS = "http://www.w3.org/2000/svg";
