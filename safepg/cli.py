@@ -1,4 +1,5 @@
-"""Command line: ``python -m safepg learn ...`` (and the experiment commands)."""
+"""Command line: ``python -m safepg learn ...`` (the method) and ``list``, ``run``, ``report``
+(the thesis's experiments). The top of both layers: nothing imports it but ``__main__``."""
 
 from __future__ import annotations
 
@@ -8,11 +9,14 @@ import os
 import sys
 from collections.abc import Sequence
 from decimal import Decimal, InvalidOperation
+from typing import Any
 
 import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.store import results_dir
+from safepg.thesis import experiments
 
 ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
 
@@ -104,13 +108,70 @@ def _run_learn(args: argparse.Namespace) -> dict:
     return out
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    from safepg.thesis import experiments  # imported here: ``learn`` alone needs none of the runner
+class NothingStoredError(LookupError):
+    """``report`` found no stored run of the experiment (the CLI exits with status 1)."""
 
+
+def _experiment_parsers(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("list", help="name every experiment")
+    p.set_defaults(func=_cmd_list)
+    p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")
+    p.add_argument("name")
+    p.add_argument("--seeds", type=positive_integer, help="number of seeds (default: the thesis's)")
+    p.add_argument("--budget", type=positive_integer, help="trajectories per run, e.g. 2e5 (default: the thesis's)")
+    p.add_argument("--jobs", type=jobs_integer, default=-1,
+                   help="parallel workers; -1 (default) all cores, -2 all but one")
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=_cmd_run)
+    p = sub.add_parser("report", help="summarise an experiment's stored runs")
+    p.add_argument("name")
+    p.add_argument("--seeds", type=positive_integer)
+    p.add_argument("--budget", type=positive_integer)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_cmd_report)
+
+
+def _run_command(args: argparse.Namespace) -> str:
+    """The ``run`` command that computes what ``report`` with these arguments reads."""
+    extra = "".join(f" --{k} {getattr(args, k)}" for k in ("seeds", "budget") if getattr(args, k) is not None)
+    return f"python -m safepg run {args.name}{extra}"
+
+
+def _cmd_list(args: argparse.Namespace) -> None:
+    for e in experiments.EXPERIMENTS.values():
+        print(f"{e.name:12s} {len(e.configs):3d} configs x {e.seeds} seeds  {e.description}")
+
+
+def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
+    exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
+    recs = experiments.run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
+    return experiments.report(exp, recs)
+
+
+def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
+    exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
+    out = experiments.report(exp)
+    # The store is keyed by settings, so "nothing stored" often means other --seeds/--budget.
+    stored, total = sum(r["seeds"] for r in out["configs"]), len(exp.configs) * exp.seeds
+    if stored == 0:
+        raise NothingStoredError(f"nothing stored for {exp.name} with these settings under {results_dir()}; "
+                                 f"compute it first with: {_run_command(args)}")
+    if stored < total:
+        print(f"safepg: note: {stored} of {total} runs of {exp.name} stored; the rest with: "
+              f"{_run_command(args)}", file=sys.stderr)
+    if args.json:
+        return out
+    for row in out["configs"]:
+        ups, ir = row["upsilon_bar"]["mean"], row["improvement_ratio"]["mean"]
+        print(f"{row['name']:40s} seeds={row['seeds']}  upsilon_bar={ups}  improvement_ratio={ir}")
+    return None
+
+
+def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="safepg", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     _learn_parser(sub)
-    experiments.add_parsers(sub)
+    _experiment_parsers(sub)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # a usage error (argparse printed it, exit status 2) or --help
@@ -124,7 +185,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, TypeError) as err:
         print(f"safepg: error: {err}", file=sys.stderr)
         return 2
-    except experiments.NothingStoredError as err:
+    except NothingStoredError as err:
         print(f"safepg: {err}", file=sys.stderr)
         return 1
     except BrokenPipeError:

@@ -15,7 +15,7 @@ import numpy as np
 
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
-from safepg.thesis.experiments import mean_ci95
+from safepg.stats import mean_ci95
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 
 

@@ -6,8 +6,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from safepg.thesis import experiments as ex
+from safepg import runner, stats, store
 from safepg.cli import main
+from safepg.thesis import experiments as ex
 
 
 @pytest.fixture()
@@ -47,15 +48,15 @@ def test_run_resume_and_invalidation(root, monkeypatch):
     assert len(files) == 6
     stamp = {f: f.stat().st_mtime_ns for f in files}
     calls = []
-    monkeypatch.setattr(ex.RunConfig, "run", lambda self, k, progress=False: calls.append((self.name, k)))
+    monkeypatch.setattr(ex.RunConfig, "run", lambda self, k, progress=False, theta0=None: calls.append((self.name, k)))
     again = ex.run_experiment(exp, jobs=1, progress=False)
     assert calls == [] and all(f.stat().st_mtime_ns == stamp[f] for f in files)
     for name in recs:
         assert all(np.array_equal(a.theta, b.theta) for a, b in zip(recs[name], again[name]))
     # Changing one config's settings invalidates only its runs.
     changed = replace(exp, configs=(replace(exp.configs[0], delta=0.9),) + exp.configs[1:])
-    assert ex._stored(ex.run_path(changed, changed.configs[0], 0), changed.configs[0]) is None
-    assert ex._stored(ex.run_path(changed, changed.configs[1], 0), changed.configs[1]) is not None
+    assert runner.stored_run(ex.experiment_folder(changed), changed.configs[0], 0) is None
+    assert runner.stored_run(ex.experiment_folder(changed), changed.configs[1], 0) is not None
 
 
 def test_same_results_in_parallel_and_serial(root, tmp_path_factory):
@@ -69,12 +70,12 @@ def test_same_results_in_parallel_and_serial(root, tmp_path_factory):
 def test_interrupted_or_partial_files_are_recomputed(root):
     exp = small(configs=1, seeds=1)
     cfg = exp.configs[0]
-    path = ex.run_path(exp, cfg, 0)
+    path = runner.run_path(ex.experiment_folder(exp), cfg, 0)
     path.parent.mkdir(parents=True)
     path.write_bytes(b"half a file")
-    assert ex._stored(path, cfg) is None
+    assert store.load_stored(path, cfg.key()) is None
     ex.run_experiment(exp, jobs=1, progress=False)
-    assert ex._stored(path, cfg) is not None
+    assert store.load_stored(path, cfg.key()) is not None
     assert not list(path.parent.glob("*.tmp.npz"))
 
 
@@ -94,10 +95,11 @@ def test_report_structure(root):
 
 
 def test_mean_ci95_matches_scipy():
-    from scipy import stats
+    from scipy import stats as scipy_stats
+
     x = [1.0, 2.0, 4.0, 3.5, 2.2]
-    lo, hi = stats.t.interval(0.95, len(x) - 1, loc=np.mean(x), scale=stats.sem(x))
-    assert ex.mean_ci95(x)["ci95"] == pytest.approx([lo, hi])
+    lo, hi = scipy_stats.t.interval(0.95, len(x) - 1, loc=np.mean(x), scale=scipy_stats.sem(x))
+    assert stats.mean_ci95(x)["ci95"] == pytest.approx([lo, hi])
 
 
 def test_cli_list_run_report(root, capsys):
@@ -157,10 +159,12 @@ def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
             for k, r in enumerate(recs[name]):
                 np.testing.assert_array_equal(r.theta[0], baselines[k].theta_final)
         assert not np.array_equal(baselines[0].theta_final, baselines[1].theta_final)
-        # The starting policy is part of a run's identity.
+        # The starting policy is part of a run's identity: the key of the run it starts from is.
         key = t54.configs[0].key()
-        mod.EXPERIMENTS["cartpole-baseline"] = replace(cheap, configs=(replace(cheap.configs[0], alpha=0.02),))
-        assert t54.configs[0].key() != key
+        assert t54.configs[0].warm_start_key == saved[
+            "cartpole-baseline"].configs[0].key()
+        other_start = replace(cheap.configs[0], alpha=0.02)
+        assert replace(t54.configs[0], warm_start_key=other_start.key()).key() != key
     finally:
         mod.EXPERIMENTS.clear()
         mod.EXPERIMENTS.update(saved)

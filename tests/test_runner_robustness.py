@@ -1,5 +1,5 @@
 """The experiment runner under real conditions: a Dask cluster, a SIGKILL, two runners at once,
-and the command line's input checks (issue 10, parts 4-6)."""
+and the command line's input checks."""
 
 import json
 import os
@@ -14,9 +14,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from safepg.thesis import experiments as ex
+from safepg import runner, store
 from safepg.cli import main
 from safepg.learning import LearningRecord
+from safepg.thesis import experiments as ex
 
 #: The campaign the kill and concurrency tests run from the command line: 2 configs x 4 seeds,
 #: 10 iterations each, about 0.25 s per run.
@@ -35,11 +36,11 @@ def _start(results: Path, *prefix: str) -> subprocess.Popen:
 
 
 def _runs(results: Path) -> list[Path]:
-    return sorted(p for p in results.rglob("seed-*.npz") if not p.name.endswith(ex.TEMP_SUFFIX))
+    return sorted(p for p in results.rglob("seed-*.npz") if not p.name.endswith(store.TEMP_SUFFIX))
 
 
 def _temps(results: Path) -> list[Path]:
-    return sorted(results.rglob(f"*{ex.TEMP_SUFFIX}"))
+    return sorted(results.rglob(f"*{store.TEMP_SUFFIX}"))
 
 
 def _report(results: Path, capsys, monkeypatch) -> dict:
@@ -82,7 +83,7 @@ def assert_same_records(a: dict[str, list[LearningRecord]], b: dict[str, list[Le
                     assert x == y, (name, f.name)
 
 
-# ------------------------------------------------------------------ part 4: a real Dask cluster
+# -------------------------------------------------------------------------- a real Dask cluster
 def test_dask_cluster_gives_the_serial_records_and_the_client_stores_them(tmp_path, monkeypatch):
     import joblib
     from distributed import Client, LocalCluster, get_task_stream
@@ -91,9 +92,9 @@ def test_dask_cluster_gives_the_serial_records_and_the_client_stores_them(tmp_pa
     exp = ex.scaled(replace(e, configs=e.configs[:2]), seeds=2, budget=10_000)
     serial = ex.run_experiment(exp, jobs=1, root=tmp_path / "serial", progress=False)
 
-    saved = []  # _save_atomic as seen by this (the client) process
-    save = ex._save_atomic
-    monkeypatch.setattr(ex, "_save_atomic", lambda rec, path: (saved.append(path), save(rec, path)))
+    saved = []  # save_atomic as seen by this (the client) process
+    save = store.save_atomic
+    monkeypatch.setattr(runner, "save_atomic", lambda rec, path: (saved.append(path), save(rec, path)))
     with (LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster,
           Client(cluster) as client):
         worker_pids = set(client.run(os.getpid).values())
@@ -127,8 +128,8 @@ def test_longest_runs_are_dispatched_first(tmp_path, monkeypatch):
     e = ex.get_experiment("table-5.2")
     exp = replace(e, configs=tuple(replace(c, budget=b) for c, b in zip(e.configs[:3], (1000, 3000, 2000))), seeds=1)
     order = []
-    compute = ex._compute
-    monkeypatch.setattr(ex, "_compute", lambda c, *a: (order.append(c.budget), compute(c, *a))[1])
+    compute = runner._compute
+    monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.budget), compute(c, *a))[1])
     ex.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
     assert order == [3000, 2000, 1000]
 
@@ -136,14 +137,14 @@ def test_longest_runs_are_dispatched_first(tmp_path, monkeypatch):
 def test_ctrl_c_inside_a_run_stops_the_campaign(tmp_path, monkeypatch):
     """A run that caught Ctrl-C returns a partial record: the runner stops instead of going on."""
     exp = ex.scaled(ex.get_experiment("table-5.1"), seeds=1, budget=10_000)
-    compute = ex._compute
-    monkeypatch.setattr(ex, "_compute", lambda *a: replace(compute(*a), interrupted=True))
+    compute = runner._compute
+    monkeypatch.setattr(runner, "_compute", lambda *a: replace(compute(*a), interrupted=True))
     with pytest.raises(KeyboardInterrupt):
         ex.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
     assert _runs(tmp_path) == [] and _temps(tmp_path) == []
 
 
-# ------------------------------------------------------------------ part 5: SIGKILL and two runners
+# -------------------------------------------------------------------------- SIGKILL and two runners
 def test_resume_after_sigkill_gives_the_uninterrupted_report(tmp_path, uninterrupted, capsys, monkeypatch):
     proc = _start(tmp_path)
     _wait_for(lambda: len(_runs(tmp_path)) >= 2, proc)
@@ -206,25 +207,25 @@ def test_only_temp_files_of_dead_writers_are_removed(tmp_path):
     zombie = subprocess.Popen([sys.executable, "-c", "pass"])
     try:
         os.waitid(os.P_PID, zombie.pid, os.WEXITED | os.WNOWAIT)  # exited, left unreaped: a zombie
-        host, folder = ex.socket.gethostname(), tmp_path / "exp" / "cfg"
+        host, folder = store.socket.gethostname(), tmp_path / "exp" / "cfg"
         folder.mkdir(parents=True)
         names = {
-            "dead": f"seed-0~{host}~{dead.pid}~abc{ex.TEMP_SUFFIX}",
-            "zombie": f"seed-1~{host}~{zombie.pid}~abc{ex.TEMP_SUFFIX}",
-            "alive": f"seed-2~{host}~{alive.pid}~abc{ex.TEMP_SUFFIX}",
-            "self": f"seed-3~{host}~{os.getpid()}~abc{ex.TEMP_SUFFIX}",
-            "other host, fresh": f"seed-4~elsewhere~{dead.pid}~abc{ex.TEMP_SUFFIX}",
-            "other host, old": f"seed-5~elsewhere~{alive.pid}~abc{ex.TEMP_SUFFIX}",
-            "older version, fresh": f"tmpab12cd{ex.TEMP_SUFFIX}",
-            "older version, old": f"tmpef34gh{ex.TEMP_SUFFIX}",
+            "dead": f"seed-0~{host}~{dead.pid}~abc{store.TEMP_SUFFIX}",
+            "zombie": f"seed-1~{host}~{zombie.pid}~abc{store.TEMP_SUFFIX}",
+            "alive": f"seed-2~{host}~{alive.pid}~abc{store.TEMP_SUFFIX}",
+            "self": f"seed-3~{host}~{os.getpid()}~abc{store.TEMP_SUFFIX}",
+            "other host, fresh": f"seed-4~elsewhere~{dead.pid}~abc{store.TEMP_SUFFIX}",
+            "other host, old": f"seed-5~elsewhere~{alive.pid}~abc{store.TEMP_SUFFIX}",
+            "older version, fresh": f"tmpab12cd{store.TEMP_SUFFIX}",
+            "older version, old": f"tmpef34gh{store.TEMP_SUFFIX}",
         }
         for label, name in names.items():
             (folder / name).write_bytes(b"partial")
             if label.endswith(", old"):
-                past = time.time() - ex.TEMP_MAX_AGE - 60
+                past = time.time() - store.TEMP_MAX_AGE - 60
                 os.utime(folder / name, (past, past))
         (folder / "seed-0.npz").write_bytes(b"a finished run is never touched")
-        removed = {p.name for p in ex.remove_stale_temp_files(tmp_path / "exp")}
+        removed = {p.name for p in store.remove_stale_temp_files(tmp_path / "exp")}
     finally:
         alive.kill()
         alive.wait()
@@ -245,12 +246,12 @@ def test_save_names_the_writer_and_leaves_nothing_on_failure(tmp_path, monkeypat
 
     record = SimpleNamespace(save=lambda p: failing_save(None, p))
     with pytest.raises(OSError, match="disk full"):
-        ex._save_atomic(record, path)  # type: ignore[arg-type]
-    assert seen[0].startswith(f"seed-0~{ex.socket.gethostname()}~{os.getpid()}~") and seen[0].endswith(".tmp.npz")
+        store.save_atomic(record, path)  # type: ignore[arg-type]
+    assert seen[0].startswith(f"seed-0~{store.socket.gethostname()}~{os.getpid()}~") and seen[0].endswith(".tmp.npz")
     assert list(tmp_path.rglob("*")) == [path.parent]
 
 
-# ------------------------------------------------------------------ part 6: command-line input
+# -------------------------------------------------------------------------- command-line input
 def _cli(capsys, *argv: str) -> tuple[int, str, str]:
     capsys.readouterr()
     code = main(list(argv))

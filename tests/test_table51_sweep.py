@@ -8,7 +8,7 @@ import pytest
 from safepg.thesis import table51_sweep as ts
 from safepg.envs.lqg import LQG
 from safepg.estimators import trajectory_scores
-from safepg.thesis.experiments import _T51_PRINTED
+from safepg.thesis.experiments import T51_PRINTED
 from safepg.policies import LinearGaussianPolicy
 
 ENV = LQG.thesis_1d()
@@ -85,10 +85,10 @@ def test_every_reading_of_the_j_formula_gives_the_same_improvement_ratio():
 def test_printed_values_are_counts_over_one_update_less_than_batches():
     # N = 10^4: 10^6 / N = 100 batches; the printed ratios are k / 99 (not k / 100).
     for sigma in (0.5, 1.0):
-        for p in _T51_PRINTED[sigma][10_000]:
+        for p in T51_PRINTED[sigma][10_000]:
             k = round(p / 100 * 99)
             assert abs(100 * k / 99 - p) < 0.006, p
-    assert any(abs(round(p) - p) > 0.01 for p in _T51_PRINTED[0.5][10_000])  # 95.96% is not k/100
+    assert any(abs(round(p) - p) > 0.01 for p in T51_PRINTED[0.5][10_000])  # 95.96% is not k/100
 
 
 def test_variant_validation_and_policy_std():

@@ -1,149 +1,49 @@
-r"""The experiments of Chapter 5, defined once as data, run in parallel, stored on disk.
+r"""The experiments of Chapter 5, defined once as data, with the values the thesis prints.
 
-An :class:`Experiment` is a named list of :class:`RunConfig` (one row of a table or one
-curve of a figure) run for several seeds. :func:`run_experiment` executes the missing
-runs through joblib (all cores by default; a user with a cluster can wrap the call in
-``joblib.parallel_config(backend="dask")`` or ``"ray"`` without code changes), shows
-tqdm progress, and writes each finished run atomically to
-``<results>/<experiment>/<config>/seed-<k>.npz`` with its config and the library
-version as metadata. An interrupted campaign resumes where it stopped; a run whose
-config or library version changed is recomputed, the others are not.
-
-Workers only compute: each returns its :class:`LearningRecord` to the calling process,
-which writes it to the store as it arrives. Workers on other machines therefore need no
-shared filesystem, and a warm start is read from the store here and sent with the task.
-Two runners on one results folder both compute the missing runs and write identical
-files; neither can corrupt the other's (see :func:`_save_atomic`).
+An :class:`Experiment` is a named group of :class:`~safepg.runner.RunConfig` (one row of
+a table or one curve of a figure) run for several seeds, with the thesis's printed values
+beside them. :func:`run_experiment` runs what is missing through :func:`safepg.runner.run_configs`
+into ``<results>/<experiment>/<config>/seed-<k>.npz`` and :func:`report` puts ours beside
+the printed values. Which run starts where another ended (the cart-pole adaptation of
+Section 5.3 starts from each seed's baseline policy) is known here: the runner only
+receives the starting points.
 
 The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
 """
 
 from __future__ import annotations
 
-import argparse
-import hashlib
-import json
-import os
-import re
-import socket
-import sys
-import tempfile
-import time
-from collections.abc import Iterable
-from dataclasses import asdict, dataclass, field, replace
-from functools import cache
+from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from tqdm.auto import tqdm
 
-from safepg.learning import CHECKPOINTS, LearningRecord, adaptive_pg, vanilla_pg
-
-#: Bump when a change to the library alters the numbers a run produces; stored runs with
-#: another version are recomputed. 2: every output computed in a CPU-independent order
-#: (safepg.portable): products instead of libm's pow, software log, sine and cosine.
-RESULTS_VERSION = "2"
-
-
-@dataclass(frozen=True)
-class RunConfig:
-    """One learning configuration (the keyword arguments of a learning loop)."""
-
-    name: str
-    algorithm: Literal["adaptive", "vanilla"] = "adaptive"
-    env: str = "lqg1d"
-    theta0: tuple[float, ...] = (0.0,)
-    sigma: float = 1.0
-    estimator: Literal["reinforce", "gpomdp"] = "gpomdp"
-    baseline: bool = True
-    bound: Literal["chebyshev", "hoeffding", "bernstein"] = "chebyshev"
-    delta: float = 0.95
-    empirical_range: bool = False
-    theoretical_range: float | None = None
-    n_min: int = 100
-    n_max: int = 500_000
-    batch_size: int | None = None
-    alpha: float | None = None
-    step: Literal["scalar", "coordinate"] = "scalar"
-    budget: int = 30_000_000
-    score_action: Literal["clipped", "raw"] = "clipped"
-    target_return: float | None = None
-    warm_start: str | None = None
-
-    def key(self) -> str:
-        """Hash of everything that determines a run's numbers (not its name)."""
-        # Unset options are left out, so adding an option later keeps existing runs valid.
-        d = {k: v for k, v in asdict(self).items() if k != "name" and v is not None}
-        if self.warm_start is not None:  # a changed starting policy must invalidate this run too
-            d["warm_start"] = [self.warm_start, _warm_start_config(self.warm_start).key()]
-        blob = json.dumps([d, RESULTS_VERSION], sort_keys=True)
-        return hashlib.sha256(blob.encode()).hexdigest()[:16]
-
-    def seed(self, k: int) -> np.random.SeedSequence:
-        """Independent stream for seed index k of this configuration."""
-        return np.random.SeedSequence([k, int(self.key(), 16) % 2**63])
-
-    def run(self, k: int, progress: bool = False, root: Path | None = None,
-            theta0: np.ndarray | None = None) -> LearningRecord:
-        """Run seed k.
-
-        With ``warm_start`` the run starts from the final theta of seed k of that
-        experiment: the cart-pole adaptation of Section 5.3 starts from each seed's own
-        baseline policy. Pass that policy as ``theta0`` (what :func:`run_experiment`
-        does, so a remote worker never reads the store); without it, it is loaded from
-        ``root`` (computed first if missing).
-        """
-        env = make_env(self.env)
-        if theta0 is not None:
-            if self.warm_start is None:
-                raise ValueError(f"theta0 is only for warm-started configs, {self.name!r} starts from "
-                                 f"{self.theta0}")
-            theta0 = np.asarray(theta0, dtype=float)
-        elif self.warm_start is not None:
-            theta0 = warm_start_theta(self.warm_start, k, root)
-        else:
-            theta0 = np.asarray(self.theta0, dtype=float)
-        common = dict(estimator=self.estimator, baseline=self.baseline, bound=self.bound,
-                      delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
-                      score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
-                      progress=progress)
-        if self.algorithm == "adaptive":
-            return adaptive_pg(env, theta0, self.sigma, n_min=self.n_min, n_max=self.n_max,
-                               theoretical_range=self.theoretical_range, **common)
-        if self.batch_size is None:
-            raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
-        # A fixed step may diverge; that is a result to report, not an error.
-        return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
-                          step=self.step, stop_on_divergence=True, target_return=self.target_return, **common)
-
+from safepg.envs.lqg import LQG
+from safepg.learning import CHECKPOINTS, LearningRecord
+from safepg.runner import RunConfig, load_configs, run_configs, store_run, stored_run
+from safepg.runner import make_env as make_core_env
+from safepg.stats import mean_ci95
+from safepg.store import results_dir
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
 #: of the printed 0.95, the discount that reproduces the printed theta*, final parameters and
 #: Table 5.3 (see :mod:`safepg.thesis.lqg_settings` and the chapter).
 LQG2D_GAMMA = 0.9
+#: Tasks of the reproduction beyond the core's named ones, by the name their runs are keyed on.
+THESIS_ENVS = {"lqg2d-gamma0.9": partial(LQG.thesis_2d, gamma=LQG2D_GAMMA)}
 
 
 def make_env(name: str) -> Any:
-    """Environment by name.
+    """Environment by name: :func:`safepg.runner.make_env`'s tasks and ``lqg2d-gamma0.9``.
 
     ``lqg1d`` (Section 5.1), ``lqg2d`` (Section 5.2 as printed, gamma = 0.95),
     ``lqg2d-gamma0.9`` (the discount the Section 5.2 experiments run with),
     ``cartpole`` and ``cartpole-doubled`` (Section 5.3: 1 m pole, then 2 m), optionally
-    with settings in brackets, ``cartpole-doubled[gamma=0.995]`` (:meth:`CartPole.from_name`).
+    with settings in brackets, ``cartpole-doubled[gamma=0.995]``.
     """
-    from safepg.envs.cartpole import CartPole
-    from safepg.envs.lqg import LQG
-
-    if name.startswith(("cartpole[", "cartpole-doubled[")):  # a setting of the cart-pole sweep
-        return CartPole.from_name(name)
-
-    envs = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d,
-            "lqg2d-gamma0.9": lambda: LQG.thesis_2d(gamma=LQG2D_GAMMA),
-            "cartpole": CartPole.thesis, "cartpole-doubled": CartPole.thesis_doubled}
-    if name not in envs:
-        raise ValueError(f"env must be one of {sorted(envs)}, got {name!r}")
-    return envs[name]()
+    return THESIS_ENVS[name]() if name in THESIS_ENVS else make_core_env(name)
 
 
 @dataclass(frozen=True)
@@ -170,10 +70,10 @@ class Experiment:
 
 
 # ------------------------------------------------------------------ Section 5.1
-_T51_ALPHAS = (1e-3, 1e-4, 1e-5, 1e-6)
-_T51_NS = (10_000, 1_000, 100)
+T51_ALPHAS = (1e-3, 1e-4, 1e-5, 1e-6)
+T51_NS = (10_000, 1_000, 100)
 #: Table 5.1 as printed: improvement ratio (%) by sigma, N, alpha.
-_T51_PRINTED = {
+T51_PRINTED = {
     0.5: {10_000: (95.96, 100, 98.99, 100), 1_000: (52.85, 73.27, 81.88, 83.88), 100: (49.79, 51.41, 55.69, 58.44)},
     1.0: {10_000: (24.24, 100, 100, 100), 1_000: (37.4, 27.03, 99.9, 100), 100: (50.4, 46.08, 39.04, 86.04)},
 }
@@ -192,8 +92,8 @@ T51_THETA0 = -0.575
 def _table_5_1(theta0: float = T51_THETA0) -> Experiment:
     configs, thesis = [], {}
     for sigma in (0.5, 1.0):
-        for n in _T51_NS:
-            for alpha, printed in zip(_T51_ALPHAS, _T51_PRINTED[sigma][n]):
+        for n in T51_NS:
+            for alpha, printed in zip(T51_ALPHAS, T51_PRINTED[sigma][n]):
                 name = f"sigma={sigma}-N={n}-alpha={alpha:.0e}"
                 configs.append(RunConfig(name, "vanilla", theta0=(theta0,), sigma=sigma, batch_size=n,
                                          alpha=alpha, budget=1_000_000))
@@ -343,7 +243,7 @@ def _table_5_4() -> Experiment:
                       "Figure 5.9).", configs, 5, thesis, "J_hat")
 
 
-# The cart-pole sweep (issue 13): which unstated settings let the adaptive step move on the
+# The cart-pole sweep: which unstated settings let the adaptive step move on the
 # doubled pole? :mod:`safepg.thesis.cartpole_sweep` computes the penalty constant over the whole grid
 # of settings analytically and reads these runs back for the chapter.
 
@@ -451,37 +351,41 @@ def _cartpole_sweep() -> Experiment:
                                    **common))
     # Every setting is held against Table 5.4 as printed (report --json shows them side by side).
     thesis = {c.name: t54.thesis["adaptive" if c.algorithm == "adaptive" else "N=4000"] for c in configs}
-    return Experiment("cartpole-sweep", "Cart-pole sweep over the unstated settings (issue 13): adaptive "
+    return Experiment("cartpole-sweep", "Cart-pole sweep over the settings the thesis leaves unstated: adaptive "
                       "(Bernstein with empirical range, delta = 0.95) and vanilla (alpha = 0.01, N = 4000) on "
                       f"the doubled pole from each setting's baseline, {SWEEP_BUDGET:.0e} trajectories, "
                       f"{SWEEP_SEEDS} seeds.", tuple(configs), SWEEP_SEEDS, thesis, "J_hat")
 
-EXPERIMENTS: dict[str, Experiment] = {
-    e.name: e for e in (_table_5_1(), _table_5_1_printed_theta0(), _table_5_1_no_baseline(), _table_5_2(),
-                        _table_5_2_lemma_range(), _table_5_2_raw_score(), _figures_5_5_5_6(), _table_5_3(),
-                        _cartpole_baseline(), _table_5_4())
-}
+def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
+    """``exp`` with each config's task factory and the key of the run it warm-starts from."""
+    configs = []
+    for c in exp.configs:
+        if c.env in THESIS_ENVS:
+            c = replace(c, env_factory=THESIS_ENVS[c.env])
+        if c.warm_start is not None:
+            c = replace(c, warm_start_key=_single_config(registry[c.warm_start]).key())
+        configs.append(c)
+    return replace(exp, configs=tuple(configs))
 
-# The cart-pole sweep's experiments (kept out of the tuple above so the two blocks are edited apart).
-EXPERIMENTS.update({e.name: e for e in (*_sweep_baselines(), _cartpole_sweep())})
 
-
-def _warm_start_config(name: str) -> RunConfig:
-    exp = get_experiment(name)
+def _single_config(exp: Experiment) -> RunConfig:
     if len(exp.configs) != 1:
-        raise ValueError(f"warm_start must name an experiment with one config, {name!r} has {len(exp.configs)}")
+        raise ValueError(f"warm_start must name an experiment with one config, {exp.name!r} has {len(exp.configs)}")
     return exp.configs[0]
 
 
-def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
-    """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
-    cfg = _warm_start_config(name)
-    path = run_path(get_experiment(name), cfg, k, root)
-    rec = _stored(path, cfg)
-    if rec is None:
-        rec = _compute(cfg, k, None, single_thread=False)
-        _store(rec, cfg, path)
-    return rec.theta_final
+def _registry() -> dict[str, Experiment]:
+    experiments = (_table_5_1(), _table_5_1_printed_theta0(), _table_5_1_no_baseline(), _table_5_2(),
+                   _table_5_2_lemma_range(), _table_5_2_raw_score(), _figures_5_5_5_6(), _table_5_3(),
+                   _cartpole_baseline(), _table_5_4(),
+                   # The cart-pole sweep's experiments.
+                   *_sweep_baselines(), _cartpole_sweep())
+    registry = {e.name: e for e in experiments}
+    return {name: _bind(e, registry) for name, e in registry.items()}
+
+
+#: Every experiment, by name.
+EXPERIMENTS: dict[str, Experiment] = _registry()
 
 
 def get_experiment(name: str) -> Experiment:
@@ -501,120 +405,20 @@ def scaled(exp: Experiment, seeds: int | None = None, budget: int | None = None)
 
 
 # ------------------------------------------------------------------ storage
-def results_dir() -> Path:
-    return Path(os.environ.get("SAFEPG_RESULTS", "results"))
+def experiment_folder(exp: Experiment | str, root: Path | None = None) -> Path:
+    """The folder of ``exp``'s runs in the store."""
+    return (root or results_dir()) / (exp if isinstance(exp, str) else exp.name)
 
 
-def run_path(exp: Experiment, cfg: RunConfig, k: int, root: Path | None = None) -> Path:
-    return (root or results_dir()) / exp.name / cfg.name / f"seed-{k}.npz"
-
-
-def _stored(path: Path, cfg: RunConfig) -> LearningRecord | None:
-    """The stored run at ``path`` if it is finished and was made by this config."""
-    if not path.exists():
-        return None
-    try:
-        rec = LearningRecord.load(path)
-    except (OSError, ValueError, KeyError):
-        return None
-    if rec.interrupted or rec.config.get("run_key") != cfg.key():
-        return None
-    return rec
-
-
-#: Suffix of a run file being written. Its name is ``<stem>~<host>~<pid>~<random>.tmp.npz``:
-#: the writer's host and process id tell a later runner whether the writer is still alive.
-TEMP_SUFFIX = ".tmp.npz"
-#: A temporary file whose writer cannot be checked (another host, or the unnamed files of
-#: older versions) is stale after this long: writing one run file takes well under a second.
-TEMP_MAX_AGE = 3600.0
-_TEMP_NAME = re.compile(r"^(?P<stem>[^~]+)~(?P<host>[^~]+)~(?P<pid>\d+)~[^~]*" + re.escape(TEMP_SUFFIX) + "$")
-
-
-def _save_atomic(rec: LearningRecord, path: Path) -> None:
-    """Write ``rec`` to ``path`` so readers see the old file or the whole new one, never half.
-
-    The record goes to a temporary file in the same folder, renamed over ``path`` when
-    complete. A writer killed mid-save (SIGKILL, power loss) leaves that temporary file
-    behind, named after its host and process id so that :func:`remove_stale_temp_files`
-    can tell it from one a live runner is still writing.
-    """
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{path.stem}~{socket.gethostname()}~{os.getpid()}~",
-                               suffix=TEMP_SUFFIX)
-    os.close(fd)
-    try:
-        rec.save(tmp)
-        os.replace(tmp, path)  # atomic on POSIX and Windows within one filesystem
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
-def _pid_alive(pid: int) -> bool:
-    """Whether process ``pid`` of this host is running (a zombie counts as dead)."""
-    if pid == os.getpid() or os.name == "nt":  # Windows' os.kill(pid, 0) would terminate the process
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # exists, owned by another user
-        return True
-    try:  # Linux: a killed child not yet reaped by its parent still answers kill(pid, 0)
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except (OSError, IndexError):
-        return True
-
-
-def remove_stale_temp_files(folder: Path) -> list[Path]:
-    """Delete the temporary run files under ``folder`` whose writer is dead; return them.
-
-    A file written by a process of this host is stale when that process no longer runs;
-    one from another host (a results folder shared over the network) or without a writer
-    in its name (older versions) when it is older than :data:`TEMP_MAX_AGE` seconds.
-    A live runner's file is never touched, so two runners can share a folder. A dead
-    writer's id reused by a new process only delays the removal to a later run.
-    """
-    removed = []
-    host, now = socket.gethostname(), time.time()
-    for tmp in sorted(folder.rglob(f"*{TEMP_SUFFIX}")) if folder.is_dir() else ():
-        m = _TEMP_NAME.match(tmp.name)
-        try:
-            if m is not None and m["host"] == host:
-                stale = not _pid_alive(int(m["pid"]))
-            else:
-                stale = now - tmp.stat().st_mtime > TEMP_MAX_AGE
-            if stale:
-                tmp.unlink()
-                removed.append(tmp)
-        except FileNotFoundError:  # its writer renamed or removed it meanwhile
-            continue
-    return removed
-
-
-def _compute(cfg: RunConfig, k: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
-    """Run seed k of ``cfg`` on a worker and return the record (the caller stores it)."""
-    if single_thread:  # joblib already uses every core; numba threads would oversubscribe
-        import numba
-
-        numba.set_num_threads(1)
-    return cfg.run(k, theta0=theta0)
-
-
-def _store(rec: LearningRecord, cfg: RunConfig, path: Path) -> None:
-    """Stamp ``rec`` with the key :func:`_stored` checks and save it (in the calling process,
-    so the stamp is this process's key whatever the worker's copy of the definitions)."""
-    rec.config["run_key"] = cfg.key()
-    rec.config["config_name"] = cfg.name
-    _save_atomic(rec, path)
-
-
-def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
-                  single_thread: bool) -> tuple[int, LearningRecord]:
-    """:func:`_compute` tagged with the task's index: results arrive in any order."""
-    return i, _compute(cfg, k, theta0, single_thread)
+def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
+    """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
+    exp = get_experiment(name)
+    cfg, folder = _single_config(exp), experiment_folder(exp, root)
+    rec = stored_run(folder, cfg, k)
+    if rec is None:
+        rec = cfg.run(k)
+        store_run(rec, folder, cfg, k)
+    return rec.theta_final
 
 
 def run_experiment(
@@ -627,100 +431,38 @@ def run_experiment(
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) of ``exp`` and return all records by config name.
 
-    Finished runs are loaded, never recomputed. The runs go to joblib's current backend
-    (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
-    worker returns its record and this process saves it as soon as it arrives, so an
-    interrupted campaign loses nothing already computed and remote workers need no
-    access to ``root``. ``jobs`` follows joblib: a positive count, or -1 for every core
-    (-2 all but one, ...).
+    Finished runs are loaded, never recomputed (:func:`safepg.runner.run_configs`, which
+    also says how to run on a Dask cluster). A warm-started experiment first runs the
+    experiment it starts from, with the same seeds, and hands each seed's final parameters
+    to the runner. ``jobs`` follows joblib: a positive count, or -1 for every core (-2 all
+    but one, ...).
     """
-    from joblib import Parallel, delayed, effective_n_jobs
-
-    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
-        raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
     exp = get_experiment(exp) if isinstance(exp, str) else exp
     exp = scaled(exp, seeds, budget)
-    # Files a killed runner was writing; a live runner's are kept.
-    remove_stale_temp_files((root or results_dir()) / exp.name)
     # Starting policies first (in parallel), so no two workers compute the same one.
     starts: dict[str, list[np.ndarray]] = {}
     for dep in sorted({c.warm_start for c in exp.configs if c.warm_start is not None}):
-        dep_exp, dep_cfg = scaled(get_experiment(dep), seeds=exp.seeds), _warm_start_config(dep)
+        dep_exp = scaled(get_experiment(dep), seeds=exp.seeds)
         run_experiment(dep_exp, jobs=jobs, root=root, progress=progress)
         # Seed by seed from its own file, so a missing seed can never shift the others.
-        dep_recs = [_stored(run_path(dep_exp, dep_cfg, k, root), dep_cfg) for k in range(exp.seeds)]
+        dep_folder, dep_cfg = experiment_folder(dep_exp, root), _single_config(dep_exp)
+        dep_recs = [stored_run(dep_folder, dep_cfg, k) for k in range(exp.seeds)]
         if any(r is None for r in dep_recs):
             raise RuntimeError(f"warm_start {dep!r}: seeds {[k for k, r in enumerate(dep_recs) if r is None]} "
                                "are not stored; rerun to compute them")
         starts[dep] = [r.theta_final for r in dep_recs]  # type: ignore[union-attr]
-    todo = [(c, k) for c in exp.configs for k in range(exp.seeds)
-            if _stored(run_path(exp, c, k, root), c) is None]
-    # Largest budgets first (the budget is the cost we know before running): a long run
-    # dispatched last would leave the other workers idle at the end. Stable, so equal
-    # budgets keep the table's order.
-    todo.sort(key=lambda ck: -ck[0].budget)
-    if todo:
-        n_jobs = effective_n_jobs(jobs)
-        tasks = (delayed(_compute_task)(i, c, k, None if c.warm_start is None else starts[c.warm_start][k],
-                                        n_jobs > 1)
-                 for i, (c, k) in enumerate(todo))
-        with tqdm(total=len(todo), desc=exp.name, unit="run", disable=not progress) as bar:
-            for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
-                if rec.interrupted:  # Ctrl-C caught by a run in this process: stop the campaign
-                    raise KeyboardInterrupt
-                c, k = todo[i]
-                _store(rec, c, run_path(exp, c, k, root))
-                bar.update()
-    return load_experiment(exp, root)
+    by_config = {c.name: starts[c.warm_start] for c in exp.configs if c.warm_start is not None}
+    return run_configs(exp.configs, exp.seeds, experiment_folder(exp, root), starts=by_config, jobs=jobs,
+                       progress=progress, desc=exp.name)
 
 
 def load_experiment(exp: Experiment | str, root: Path | None = None) -> dict[str, list[LearningRecord]]:
     """Finished runs of ``exp`` by config name (missing seeds are left out)."""
     exp = get_experiment(exp) if isinstance(exp, str) else exp
-    out: dict[str, list[LearningRecord]] = {}
-    for c in exp.configs:
-        recs = [_stored(run_path(exp, c, k, root), c) for k in range(exp.seeds)]
-        out[c.name] = [r for r in recs if r is not None]
-    return out
+    return load_configs(exp.configs, exp.seeds, experiment_folder(exp, root))
 
 
 # ------------------------------------------------------------------ report
-def mean_ci95(values: Iterable[float]) -> dict[str, Any]:
-    """Mean and 95% Student-t confidence interval over seeds."""
-    x = np.asarray(list(values), dtype=float)
-    if x.size == 0:
-        return {"mean": None, "ci95": [None, None]}
-    m = float(x.mean())
-    if x.size < 2:
-        return {"mean": m, "ci95": [m, m]}
-    h = float(t_quantile_975(x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
-    return {"mean": m, "ci95": [m - h, m + h]}
-
-
-@cache
-def t_quantile_975(df: int) -> float:
-    """0.975 quantile of Student's t with ``df`` degrees of freedom.
-
-    Computed with mpmath (software arithmetic), not ``scipy.stats.t.ppf``, whose special
-    functions call libm and can differ across CPUs in the last bit of a reported interval.
-    Solves :math:`I_x(df/2, 1/2) = 0.05` for :math:`x = df / (df + t^2)`.
-    """
-    import mpmath
-
-    if int(df) != df or df < 1:
-        raise ValueError(f"df must be a positive integer, got {df}")
-    with mpmath.workdps(40):
-        a = mpmath.mpf(df) / 2
-        lo, hi = mpmath.mpf(0), mpmath.mpf(1)
-        for _ in range(80):  # bisection: I_x increases in x; x > 0.006 for df >= 1, so 2^-80 is below its ulp
-            mid = (lo + hi) / 2
-            if mpmath.betainc(a, 0.5, 0, mid, regularized=True) < mpmath.mpf("0.05"):
-                lo = mid
-            else:
-                hi = mid
-        return float(mpmath.sqrt(df * (1 - lo) / lo))
-
-
 def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,
            root: Path | None = None) -> dict[str, Any]:
     """One JSON-ready object per configuration, with the thesis's printed values beside ours."""
@@ -757,65 +499,3 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
             "thesis": exp.thesis.get(c.name),
         })
     return {"experiment": exp.name, "configs": rows}
-
-
-# ------------------------------------------------------------------ command line
-class NothingStoredError(LookupError):
-    """``report`` found no stored run of the experiment (the CLI exits with status 1)."""
-
-
-def add_parsers(sub: argparse._SubParsersAction) -> None:
-    from safepg.cli import jobs_integer, positive_integer
-
-    p = sub.add_parser("list", help="name every experiment")
-    p.set_defaults(func=_cmd_list)
-    p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")
-    p.add_argument("name")
-    p.add_argument("--seeds", type=positive_integer, help="number of seeds (default: the thesis's)")
-    p.add_argument("--budget", type=positive_integer, help="trajectories per run, e.g. 2e5 (default: the thesis's)")
-    p.add_argument("--jobs", type=jobs_integer, default=-1,
-                   help="parallel workers; -1 (default) all cores, -2 all but one")
-    p.add_argument("--quiet", action="store_true")
-    p.set_defaults(func=_cmd_run)
-    p = sub.add_parser("report", help="summarise an experiment's stored runs")
-    p.add_argument("name")
-    p.add_argument("--seeds", type=positive_integer)
-    p.add_argument("--budget", type=positive_integer)
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=_cmd_report)
-
-
-def _run_command(args: argparse.Namespace) -> str:
-    """The ``run`` command that computes what ``report`` with these arguments reads."""
-    extra = "".join(f" --{k} {getattr(args, k)}" for k in ("seeds", "budget") if getattr(args, k) is not None)
-    return f"python -m safepg run {args.name}{extra}"
-
-
-def _cmd_list(args: argparse.Namespace) -> None:
-    for e in EXPERIMENTS.values():
-        print(f"{e.name:12s} {len(e.configs):3d} configs x {e.seeds} seeds  {e.description}")
-
-
-def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
-    exp = scaled(get_experiment(args.name), args.seeds, args.budget)
-    recs = run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
-    return report(exp, recs)
-
-
-def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
-    exp = scaled(get_experiment(args.name), args.seeds, args.budget)
-    out = report(exp)
-    # The store is keyed by settings, so "nothing stored" often means other --seeds/--budget.
-    stored, total = sum(r["seeds"] for r in out["configs"]), len(exp.configs) * exp.seeds
-    if stored == 0:
-        raise NothingStoredError(f"nothing stored for {exp.name} with these settings under {results_dir()}; "
-                                 f"compute it first with: {_run_command(args)}")
-    if stored < total:
-        print(f"safepg: note: {stored} of {total} runs of {exp.name} stored; the rest with: "
-              f"{_run_command(args)}", file=sys.stderr)
-    if args.json:
-        return out
-    for row in out["configs"]:
-        ups, ir = row["upsilon_bar"]["mean"], row["improvement_ratio"]["mean"]
-        print(f"{row['name']:40s} seeds={row['seeds']}  upsilon_bar={ups}  improvement_ratio={ir}")
-    return None

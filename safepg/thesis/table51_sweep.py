@@ -290,17 +290,17 @@ CHAPTER_PLAN: tuple[tuple[Variant, float], ...] = _plan_default()
 
 
 def _printed() -> dict[float, dict[int, tuple[float, ...]]]:
-    from safepg.thesis.experiments import _T51_PRINTED
+    from safepg.thesis.experiments import T51_PRINTED
 
-    return _T51_PRINTED
+    return T51_PRINTED
 
 
 def table_cells() -> list[tuple[float, int, float, float]]:
     """(sigma, N, alpha, printed ratio in [0, 1]) for the 24 cells of Table 5.1."""
-    from safepg.thesis.experiments import _T51_ALPHAS, _T51_NS
+    from safepg.thesis.experiments import T51_ALPHAS, T51_NS
 
-    return [(s, n, a, round(p / 100, 6)) for s in (0.5, 1.0) for n in _T51_NS
-            for a, p in zip(_T51_ALPHAS, _printed()[s][n])]
+    return [(s, n, a, round(p / 100, 6)) for s in (0.5, 1.0) for n in T51_NS
+            for a, p in zip(T51_ALPHAS, _printed()[s][n])]
 
 
 def cell_name(sigma: float, n: int, alpha: float) -> str:
@@ -343,7 +343,7 @@ def sweep_paths(plan: Sequence[tuple[Variant, float]] = CHAPTER_PLAN, seeds: int
     """
     from joblib import Parallel, delayed
 
-    from safepg.thesis.experiments import results_dir
+    from safepg.store import results_dir
 
     if int(seeds) != seeds or seeds < 1:
         raise ValueError(f"seeds must be a positive integer, got {seeds}")

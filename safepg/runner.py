@@ -1,0 +1,249 @@
+r"""Learning runs defined as data, run for several seeds in parallel, kept in the store.
+
+A :class:`RunConfig` is one learning configuration: the task (a name or a factory), the
+algorithm and its arguments. Its :meth:`~RunConfig.key` hashes everything that determines
+the run's numbers; seed ``k`` draws from a stream derived from that key, so the same
+configuration and seed give the same numbers on any machine and in any order.
+
+:func:`run_configs` executes the missing (config, seed) runs of a group of configurations
+through joblib (all cores by default; a user with a cluster wraps the call in
+``joblib.parallel_config(backend="dask")`` or ``"ray"`` without code changes), shows tqdm
+progress, and writes each finished run atomically to ``<folder>/<config>/seed-<k>.npz``
+(:mod:`safepg.store`). An interrupted campaign resumes where it stopped; a run whose
+settings or library version changed is recomputed, the others are not.
+
+Workers only compute: each returns its :class:`~safepg.learning.LearningRecord` to the
+calling process, which writes it to the store as it arrives. Workers on other machines
+therefore need no shared filesystem. A run that starts where another ended (a *warm
+start*) receives its starting parameters as data, one per seed, from the caller.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.store import load_stored, remove_stale_temp_files, save_atomic
+
+#: Bump when a change to the library alters the numbers a run produces; stored runs with
+#: another version are recomputed. 2: every output computed in a CPU-independent order
+#: (safepg.portable): products instead of libm's pow, software log, sine and cosine.
+RESULTS_VERSION = "2"
+
+
+def make_env(name: str) -> Any:
+    """Environment by name.
+
+    ``lqg1d`` and ``lqg2d`` (:meth:`LQG.thesis_1d <safepg.envs.lqg.LQG.thesis_1d>`,
+    :meth:`~safepg.envs.lqg.LQG.thesis_2d`), ``cartpole`` and ``cartpole-doubled`` (1 m
+    pole, then 2 m), optionally with settings in brackets,
+    ``cartpole-doubled[gamma=0.995]`` (:meth:`CartPole.from_name
+    <safepg.envs.cartpole.CartPole.from_name>`). Other tasks are given to a
+    :class:`RunConfig` as a factory.
+    """
+    from safepg.envs.cartpole import CartPole
+    from safepg.envs.lqg import LQG
+
+    if name.startswith(("cartpole[", "cartpole-doubled[")):
+        return CartPole.from_name(name)
+    envs = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d,
+            "cartpole": CartPole.thesis, "cartpole-doubled": CartPole.thesis_doubled}
+    if name not in envs:
+        raise ValueError(f"env must be one of {sorted(envs)} or given as env_factory, got {name!r}")
+    return envs[name]()
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """One learning configuration (the keyword arguments of a learning loop).
+
+    ``env`` names the task; a task :func:`make_env` does not know is built by
+    ``env_factory`` (a picklable callable with no arguments), and ``env`` is then the name
+    that enters the key. ``warm_start`` names the run whose final parameters, seed by seed,
+    start this one, and ``warm_start_key`` is that run's :meth:`key`, so that a changed
+    starting run changes this run's key too.
+    """
+
+    name: str
+    algorithm: Literal["adaptive", "vanilla"] = "adaptive"
+    env: str = "lqg1d"
+    theta0: tuple[float, ...] = (0.0,)
+    sigma: float = 1.0
+    estimator: Literal["reinforce", "gpomdp"] = "gpomdp"
+    baseline: bool = True
+    bound: Literal["chebyshev", "hoeffding", "bernstein"] = "chebyshev"
+    delta: float = 0.95
+    empirical_range: bool = False
+    theoretical_range: float | None = None
+    n_min: int = 100
+    n_max: int = 500_000
+    batch_size: int | None = None
+    alpha: float | None = None
+    step: Literal["scalar", "coordinate"] = "scalar"
+    budget: int = 30_000_000
+    score_action: Literal["clipped", "raw"] = "clipped"
+    target_return: float | None = None
+    warm_start: str | None = None
+    warm_start_key: str | None = field(default=None, repr=False)
+    env_factory: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
+
+    def key(self) -> str:
+        """Hash of everything that determines a run's numbers (not its name)."""
+        # Unset options are left out, so adding an option later keeps existing runs valid.
+        d = {k: v for k, v in asdict(self).items()
+             if k not in ("name", "warm_start_key", "env_factory") and v is not None}
+        if self.warm_start is not None:  # a changed starting policy must invalidate this run too
+            if self.warm_start_key is None:
+                raise ValueError(f"warm_start_key must be given with warm_start={self.warm_start!r} "
+                                 f"(config {self.name!r}): the key of the run it starts from")
+            d["warm_start"] = [self.warm_start, self.warm_start_key]
+        blob = json.dumps([d, RESULTS_VERSION], sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def seed(self, k: int) -> np.random.SeedSequence:
+        """Independent stream for seed index k of this configuration."""
+        return np.random.SeedSequence([k, int(self.key(), 16) % 2**63])
+
+    def make_env(self) -> Any:
+        """The task this configuration learns on."""
+        return self.env_factory() if self.env_factory is not None else make_env(self.env)
+
+    def run(self, k: int, progress: bool = False, theta0: np.ndarray | None = None) -> LearningRecord:
+        """Run seed k.
+
+        A warm-started configuration starts from ``theta0``, the final parameters of seed k
+        of the run it names; any other starts from its own ``theta0`` field.
+        """
+        env = self.make_env()
+        if self.warm_start is not None:
+            if theta0 is None:
+                raise ValueError(f"theta0 must be given for the warm-started config {self.name!r}: "
+                                 f"the final theta of seed {k} of {self.warm_start!r}")
+            theta0 = np.asarray(theta0, dtype=float)
+        elif theta0 is not None:
+            raise ValueError(f"theta0 is only for warm-started configs, {self.name!r} starts from {self.theta0}")
+        else:
+            theta0 = np.asarray(self.theta0, dtype=float)
+        common = dict(estimator=self.estimator, baseline=self.baseline, bound=self.bound,
+                      delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
+                      score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
+                      progress=progress)
+        if self.algorithm == "adaptive":
+            return adaptive_pg(env, theta0, self.sigma, n_min=self.n_min, n_max=self.n_max,
+                               theoretical_range=self.theoretical_range, **common)
+        if self.batch_size is None:
+            raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
+        # A fixed step may diverge; that is a result to report, not an error.
+        return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
+                          step=self.step, stop_on_divergence=True, target_return=self.target_return, **common)
+
+
+def run_path(folder: Path, cfg: RunConfig, k: int) -> Path:
+    """Where seed k of ``cfg`` is stored in a group's folder."""
+    return folder / cfg.name / f"seed-{k}.npz"
+
+
+def stored_run(folder: Path, cfg: RunConfig, k: int) -> LearningRecord | None:
+    """Seed k of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise)."""
+    return load_stored(run_path(folder, cfg, k), cfg.key())
+
+
+def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, k: int) -> None:
+    """Stamp ``rec`` with the key :func:`stored_run` checks and save it (in the calling process,
+    so the stamp is this process's key whatever the worker's copy of the definitions)."""
+    rec.config["run_key"] = cfg.key()
+    rec.config["config_name"] = cfg.name
+    save_atomic(rec, run_path(folder, cfg, k))
+
+
+def _compute(cfg: RunConfig, k: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
+    """Run seed k of ``cfg`` on a worker and return the record (the caller stores it)."""
+    if single_thread:  # joblib already uses every core; numba threads would oversubscribe
+        import numba
+
+        numba.set_num_threads(1)
+    return cfg.run(k, theta0=theta0)
+
+
+def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
+                  single_thread: bool) -> tuple[int, LearningRecord]:
+    """:func:`_compute` tagged with the task's index: results arrive in any order."""
+    return i, _compute(cfg, k, theta0, single_thread)
+
+
+def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path) -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``configs`` by config name (missing seeds are left out)."""
+    out: dict[str, list[LearningRecord]] = {}
+    for c in configs:
+        recs = [stored_run(folder, c, k) for k in range(seeds)]
+        out[c.name] = [r for r in recs if r is not None]
+    return out
+
+
+def run_configs(
+    configs: Sequence[RunConfig],
+    seeds: int,
+    folder: Path,
+    starts: Mapping[str, Sequence[np.ndarray]] | None = None,
+    jobs: int = -1,
+    progress: bool = True,
+    desc: str | None = None,
+) -> dict[str, list[LearningRecord]]:
+    """Run every missing (config, seed) and return all records by config name.
+
+    Parameters
+    ----------
+    configs
+        The configurations, each run for seeds ``0 .. seeds - 1``.
+    seeds
+        Number of seeds.
+    folder
+        The group's folder in the store; seed k of config ``c`` is ``folder/c.name/seed-k.npz``.
+    starts
+        For each warm-started config (by name), its starting parameters seed by seed.
+    jobs
+        joblib's ``n_jobs``: a positive count, or -1 for every core (-2 all but one, ...).
+    progress, desc
+        tqdm progress bar and its label (default: the folder's name).
+
+    Finished runs are loaded, never recomputed. The runs go to joblib's current backend
+    (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
+    worker returns its record and this process saves it as soon as it arrives, so an
+    interrupted campaign loses nothing already computed and remote workers need no
+    access to ``folder``.
+    """
+    from joblib import Parallel, delayed, effective_n_jobs
+
+    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
+        raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
+    starts = starts or {}
+    for c in configs:
+        if c.warm_start is not None and len(starts.get(c.name, ())) < seeds:
+            raise ValueError(f"starts must give {seeds} starting points for the warm-started config {c.name!r}")
+    # Files a killed runner was writing; a live runner's are kept.
+    remove_stale_temp_files(folder)
+    todo = [(c, k) for c in configs for k in range(seeds) if stored_run(folder, c, k) is None]
+    # Largest budgets first (the budget is the cost we know before running): a long run
+    # dispatched last would leave the other workers idle at the end. Stable, so equal
+    # budgets keep the given order.
+    todo.sort(key=lambda ck: -ck[0].budget)
+    if todo:
+        n_jobs = effective_n_jobs(jobs)
+        tasks = (delayed(_compute_task)(i, c, k, None if c.warm_start is None else starts[c.name][k], n_jobs > 1)
+                 for i, (c, k) in enumerate(todo))
+        with tqdm(total=len(todo), desc=desc or folder.name, unit="run", disable=not progress) as bar:
+            for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+                if rec.interrupted:  # Ctrl-C caught by a run in this process: stop the campaign
+                    raise KeyboardInterrupt
+                c, k = todo[i]
+                store_run(rec, folder, c, k)
+                bar.update()
+    return load_configs(configs, seeds, folder)
