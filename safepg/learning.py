@@ -18,7 +18,6 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from safepg import portable
-from safepg.rng import RNGLike, as_generator
 from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
 from safepg.constants import BoundedTask, TaskConstants
 from safepg.estimators import Estimator, ScoreAction, gradient_samples
@@ -30,6 +29,7 @@ from safepg.meta import (
     scalar_step,
 )
 from safepg.policies import LinearGaussianPolicy
+from safepg.rng import RNGLike, as_generator
 from safepg.trajectories import Trajectories
 
 #: Trajectory counts at which Figures 5.1-5.2 are read off (``LearningRecord.J_at``).

@@ -13,7 +13,7 @@ from safepg import portable
 from safepg.rng import RNGLike, as_generator
 
 
-def _check_sigma(sigma: float | np.ndarray, action_dim: int) -> np.ndarray:
+def check_sigma(sigma: float | np.ndarray, action_dim: int) -> np.ndarray:
     """Return the covariance matrix for ``sigma`` (a std, a vector of stds or a covariance)."""
     s = np.asarray(sigma, dtype=float)
     if not np.all(np.isfinite(s)):
@@ -56,7 +56,7 @@ class LinearGaussianPolicy:
         if not np.all(np.isfinite(K)):
             raise ValueError("theta must be finite (got NaN or inf in the gain)")
         self.gain = K
-        self.cov = _check_sigma(sigma, K.shape[0])
+        self.cov = check_sigma(sigma, K.shape[0])
         # Fixed-order factorisations (safepg.portable): LAPACK's last bit depends on the CPU.
         self.cov_chol = portable.cholesky(self.cov)
         self.precision = portable.solve(self.cov, np.eye(self.cov.shape[0]))

@@ -1,4 +1,4 @@
-"""Outputs that do not depend on the CPU (issue 10; :mod:`safepg.portable`).
+"""Outputs that do not depend on the CPU (:mod:`safepg.portable`).
 
 Two kinds of evidence, without touching the machine's BLAS settings:
 
@@ -221,7 +221,7 @@ ALLOWED = {
     # yes/no answers: only a gain exactly on the stability boundary could flip
     ("envs/lqg", "_stable"), ("envs/lqg", "_largest_eigenvalue"),
     # validation, and full (non-diagonal) covariances, which no experiment uses
-    ("policies", "_check_sigma"), ("policies", "sigma"), ("policies", "log_density"),
+    ("policies", "check_sigma"), ("policies", "sigma"), ("policies", "log_density"),
     # a cross-check of the Bernstein search in the tests, never an output
     ("meta", "n_star_bernstein_root"),
 }

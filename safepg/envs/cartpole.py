@@ -59,10 +59,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from safepg import portable
-from safepg.rng import RNGLike, as_generator
 from safepg.constants import HORIZON_TERMS
 from safepg.estimators import check_estimator, check_score_action
-from safepg.policies import LinearGaussianPolicy, _check_sigma
+from safepg.policies import LinearGaussianPolicy, check_sigma
+from safepg.rng import RNGLike, as_generator
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -526,7 +526,7 @@ class CartPole:
             raise ValueError(f"gain must have shape (1, 4) or (4,), got {np.shape(gain)}")
         if not np.all(np.isfinite(K)):
             raise ValueError(f"gain must be finite, got {K.ravel()}")
-        _check_sigma(sigma, self.action_dim)  # raises "sigma ..." errors before the policy does
+        check_sigma(sigma, self.action_dim)  # raises "sigma ..." errors before the policy does
         return self.simulate(LinearGaussianPolicy(K, sigma), n, rng)
 
     # ------------------------------------------------------------------- metrics

@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from safepg import portable
-from safepg.rng import RNGLike, as_generator
 from safepg.estimators import check_estimator, check_score_action
-from safepg.policies import LinearGaussianPolicy, _check_sigma
+from safepg.policies import LinearGaussianPolicy, check_sigma
+from safepg.rng import RNGLike, as_generator
 from safepg.trajectories import Trajectories
 
 
@@ -257,7 +257,7 @@ class LQG:
         if not np.all(np.isfinite(T)):
             raise ValueError("thetas must be finite")
         _, B, _, R = self._mats
-        S = _check_sigma(sigma, d)
+        S = check_sigma(sigma, d)
         K = T.reshape(-1, d, d)
         stable = self._stable(K)
         # Unstable rows get K = 0 (a regular system); they are -inf below.
@@ -281,7 +281,7 @@ class LQG:
         A, B, _, R = self._mats
         mm = portable.matmul
         K = self._gain(theta)
-        S = _check_sigma(sigma, self.dim)
+        S = check_sigma(sigma, self.dim)
         P = self.value_matrix(K)
         F = A + mm(B, K)
         W = self.initial_second_moment() + self.gamma * mm(mm(B, S), B.T) / (1 - self.gamma)

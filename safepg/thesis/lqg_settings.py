@@ -38,9 +38,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from safepg import portable
-from safepg.rng import RNGLike, as_generator
 from safepg.envs.lqg import LQG
-from safepg.policies import LinearGaussianPolicy, _check_sigma
+from safepg.policies import LinearGaussianPolicy, check_sigma
+from safepg.rng import RNGLike, as_generator
 
 #: Numbers printed in Section 5.2.1 (theta* is the (1,1) = (2,2) entry).
 PRINTED_THETA_STAR = -0.588
@@ -89,7 +89,7 @@ def second_moments(env: LQG, theta: np.ndarray | float, sigma: float | np.ndarra
     _check_horizon(horizon)
     A, B, _, _ = env._mats
     K = env._gain(theta)
-    S_pol = _check_sigma(sigma, env.dim)
+    S_pol = check_sigma(sigma, env.dim)
     mm = portable.matmul  # fixed-order products: these values are printed (safepg.portable)
     F = A + mm(B, K)
     noise = mm(mm(B, S_pol), B.T)
@@ -113,7 +113,7 @@ def expected_rewards(env: LQG, theta: np.ndarray | float, sigma: float | np.ndar
     """
     _, _, Q, R = env._mats
     K = env._gain(theta)
-    S_pol = _check_sigma(sigma, env.dim)
+    S_pol = check_sigma(sigma, env.dim)
     S = second_moments(env, K, sigma, horizon)
     mm = portable.matmul
     action_m2 = mm(mm(K, S), K.T) + S_pol  # (H, m, m)

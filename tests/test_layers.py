@@ -1,0 +1,162 @@
+"""The import rules of the two layers, read from the source (nothing of ``safepg`` is imported).
+
+- the core (``safepg`` outside ``safepg.thesis``, ``safepg.cli`` and ``safepg.__main__``)
+  imports nothing from ``safepg.thesis`` or ``safepg.cli``;
+- only ``safepg.__main__`` imports ``safepg.cli``;
+- the modules import one another without cycles;
+- no module imports another's private names, nor a private module from another directory;
+- no module is longer than :data:`MAX_LINES` unless :data:`LONG_MODULES` says why.
+
+The graph and the rules are in ``tests/layers.py``; :func:`test_probe_rules_fail` runs them on
+small fake trees to show that each rule reports what it should, and nothing on a clean tree.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from layers import Tree, cycles, importer_violations, layer_violations, private_violations, scan, size_violations
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = "safepg"
+THESIS = f"{PACKAGE}.thesis"
+CLI = f"{PACKAGE}.cli"
+ENTRY = f"{PACKAGE}.__main__"
+#: A module longer than this is split, or listed in :data:`LONG_MODULES`.
+MAX_LINES = 600
+#: Modules allowed over :data:`MAX_LINES`: ``{path relative to the repository: why it is one concept}``.
+#: Empty on purpose until the split of the package into its two layers is done; an entry is
+#: added only with the reason the module cannot be cut into smaller ones, and an entry whose
+#: module is gone or back under the limit fails the test.
+LONG_MODULES: dict[str, str] = {}
+
+
+def check_layers(tree: Tree) -> list[str]:
+    """Core modules importing the thesis layer or the command line."""
+    return layer_violations(tree, upper=(THESIS, CLI), exempt=(THESIS, CLI, ENTRY))
+
+
+def check_cli(tree: Tree) -> list[str]:
+    """Modules other than the entry point importing the command line."""
+    return importer_violations(tree, CLI, allowed=(ENTRY,))
+
+
+def check_size(tree: Tree, allowed: dict[str, str] = LONG_MODULES) -> list[str]:
+    """Modules over :data:`MAX_LINES` lines not allowed by ``allowed``."""
+    return size_violations(tree, MAX_LINES, allowed)
+
+
+def report(what: str, found: list[str]) -> str:
+    return f"{len(found)} {what}:\n  " + "\n  ".join(found)
+
+
+@pytest.fixture(scope="module")
+def tree() -> Tree:
+    return scan(ROOT / PACKAGE)
+
+
+def test_scan_sees_the_package(tree: Tree) -> None:
+    assert {PACKAGE, CLI, ENTRY, THESIS, f"{PACKAGE}.policies"} <= set(tree.modules)
+    assert tree.imports
+
+
+def test_core_does_not_import_thesis_or_cli(tree: Tree) -> None:
+    found = check_layers(tree)
+    assert not found, report(f"imports of {THESIS} or {CLI} by the core", found)
+
+
+def test_only_main_imports_cli(tree: Tree) -> None:
+    found = check_cli(tree)
+    assert not found, report(f"imports of {CLI} outside {ENTRY}", found)
+
+
+def test_no_import_cycles(tree: Tree) -> None:
+    found = cycles(tree)
+    assert not found, report("import cycles", found)
+
+
+def test_no_private_imports(tree: Tree) -> None:
+    found = private_violations(tree)
+    assert not found, report("imports of private names or modules", found)
+
+
+def test_module_size(tree: Tree) -> None:
+    found = check_size(tree)
+    assert not found, report(f"modules over {MAX_LINES} lines (split them, or say why in LONG_MODULES)", found)
+
+
+# ------------------------------------------------------------------ probe
+CLEAN = {
+    "__init__.py": '"""Package."""\nfrom safepg.core import Thing\nfrom . import util\n__version__ = "0"\n',
+    "__main__.py": "from safepg.cli import main\n\nraise SystemExit(main())\n",
+    "cli.py": "from safepg import core\n\n\ndef main():\n    from safepg.thesis import report\n    return 0\n",
+    # the parent's __init__ imports core; core reaching a sibling through the parent is no edge back
+    "core.py": ("from typing import TYPE_CHECKING\n\nfrom safepg import util\nfrom safepg.util import helper\n"
+                "\nif TYPE_CHECKING:\n    from safepg.envs import Env\n\n\nclass Thing:\n    pass\n"),
+    # importing safepg.envs.env runs safepg/__init__.py, which imports util: implicit, no edge
+    "util.py": "import safepg.envs.env as env_module\n\n\ndef helper():\n    return env_module.__name__\n",
+    "envs/__init__.py": "from .env import Env\n",
+    "envs/env.py": "from . import _kernel\nfrom ._kernel import fast\n\n\nclass Env:\n    pass\n",
+    "envs/_kernel.py": "def fast():\n    pass\n",
+    "thesis/__init__.py": "",
+    "thesis/report.py": ("from safepg import Thing, __version__\nfrom safepg.core import Thing as T\n"
+                         "from ..util import helper\n"),
+    "long.py": "x = 1\n" * MAX_LINES,
+}
+#: Each violating file, with the line numbers and fragments its report must show.
+DIRTY = {
+    "layer.py": "import os\n\n\ndef f():\n    from safepg.thesis import report\n",
+    "typed.py": "from typing import TYPE_CHECKING\n\nif TYPE_CHECKING:\n    import safepg.thesis.report\n",
+    "a.py": "from safepg.b import x\n",
+    "b.py": "x = 1\nfrom . import a\n",
+    "c.py": "from safepg import Thing\n\nC = Thing\n",
+    "__init__.py": CLEAN["__init__.py"] + "from safepg.c import C\n",
+    "private.py": "from safepg.core import _hidden\nimport safepg.util as u\n\nu._cache.clear()\n",
+    "envs/_kernel.py": "def fast():\n    pass\n\n\n_hidden = 0\n",
+    "reach.py": "from safepg.envs._kernel import fast\n\n\ndef g():\n    from safepg.envs import _kernel\n",
+    "thesis/runner.py": "from safepg.cli import main\n",
+    "huge.py": "x = 1\n" * (MAX_LINES + 1),
+}
+
+
+def write(root: Path, files: dict[str, str]) -> Tree:
+    for name, text in files.items():
+        path = root / PACKAGE / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return scan(root / PACKAGE)
+
+
+def test_probe_clean_tree_passes(tmp_path: Path) -> None:
+    tree = write(tmp_path, CLEAN)
+    assert len(tree.modules) == len(CLEAN)
+    assert check_layers(tree) == []
+    assert check_cli(tree) == []
+    assert cycles(tree) == []
+    assert private_violations(tree) == []
+    assert check_size(tree, allowed={}) == []  # long.py is at the limit, not over
+
+
+def test_probe_rules_fail(tmp_path: Path) -> None:
+    tree = write(tmp_path, {**CLEAN, **DIRTY})
+
+    assert check_layers(tree) == [
+        "safepg/layer.py:5: safepg.layer imports safepg.thesis.report",
+        "safepg/typed.py:4: safepg.typed imports safepg.thesis.report",
+    ]
+    assert check_cli(tree) == ["safepg/thesis/runner.py:1: safepg.thesis.runner imports safepg.cli"]
+    assert cycles(tree) == [
+        "safepg -> safepg.c -> safepg  (safepg/__init__.py:5, safepg/c.py:1)",
+        "safepg.a -> safepg.b -> safepg.a  (safepg/a.py:1, safepg/b.py:2)",
+    ]
+    assert private_violations(tree) == [
+        "safepg/private.py:1: safepg.private imports the private name _hidden of safepg.core",
+        "safepg/private.py:4: safepg.private reads the private name _cache of safepg.util",
+        "safepg/reach.py:1: safepg.reach imports the private module safepg.envs._kernel, private to safepg.envs",
+        "safepg/reach.py:5: safepg.reach imports the private module safepg.envs._kernel, private to safepg.envs",
+    ]
+    assert check_size(tree) == [f"safepg/huge.py:1: {MAX_LINES + 1} lines (> {MAX_LINES})"]
+    assert check_size(tree, allowed={"safepg/huge.py": "one table", "safepg/gone.py": "split"}) == [
+        "safepg/gone.py: in the allow-list but absent",
+    ]
