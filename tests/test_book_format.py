@@ -1,5 +1,5 @@
 """How the book presents results: captioned tables, thesis numbering, the errata page,
-figure axes (issue 11). The browser test (test_browser_book.py) checks the built pages."""
+figure axes. The browser test (test_browser_book.py) checks the built pages."""
 
 from __future__ import annotations
 
@@ -99,7 +99,7 @@ def test_renumbering_overrides_sphinx_counts():
 
 
 def test_figure_4_1_tick_labels_do_not_overlap():
-    """The symmetric-log axis of Figure 4.1 used to print crowded labels around 0."""
+    """The symmetric-log axis of Figure 4.1 prints no crowded, overlapping labels around 0."""
     from safepg.bounds import ErrorBound
     from safepg.thesis.figures import figure_4_1
 

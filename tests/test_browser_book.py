@@ -278,7 +278,7 @@ def _distorted_images(pg: OfflinePage) -> list[str]:
 
 
 def test_every_page_reads_well(browser, book):
-    """The page-wide reading checks of issue 11 (see the module docstring), on every page of
+    """The page-wide reading checks (see the module docstring), on every page of
     ``_toc.yml``, at 1280 and 390 px, in the light and the dark theme."""
     problems: dict[str, Any] = {}
     captions_by_page: dict[str, list[str]] = {}

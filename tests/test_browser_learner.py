@@ -22,7 +22,7 @@ from browser_pages import OfflinePage
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
 pytestmark = pytest.mark.browser
-#: Generous: the build machine is shared; the target (issue 12) is < 1 s, reported by the test.
+#: Generous: the build machine is shared; the target is < 1 s, reported by the test.
 MAX_RUN_SECONDS = 20.0
 
 

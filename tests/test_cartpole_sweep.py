@@ -1,5 +1,6 @@
-"""The cart-pole sweep of issue 13: the settings as CartPole / TaskConstants parameters, the
-generalised penalty constant, the analytic grid, the sweep's experiments and its summaries."""
+"""The cart-pole sweep over the settings the thesis leaves unstated: the settings as CartPole /
+TaskConstants parameters, the generalised penalty constant, the analytic grid, the sweep's
+experiments and its summaries."""
 
 from __future__ import annotations
 

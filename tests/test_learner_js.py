@@ -1,4 +1,5 @@
-"""The JavaScript learner of the live explorer (safepg/thesis/explorers/static/learner.js) against safepg, under Node.js.
+"""The live explorer's JavaScript learner (safepg/thesis/explorers/static/learner.js) against safepg,
+under Node.js.
 
 Deterministic parts: given the same inputs (gradient-sample arrays, random numbers), the
 JavaScript and Python implementations give the same bounds (d, f, eps), N*, step and
@@ -19,6 +20,7 @@ import math
 import shutil
 import subprocess
 import tempfile
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -36,11 +38,12 @@ from safepg.bounds import (
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg
-from safepg.thesis.explorers.live_learner import task_data
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
+from safepg.thesis.explorers.live_learner import task_data
 
 NODE = shutil.which("node")
-LEARNER = Path(__file__).resolve().parents[1] / "safepg" / "static" / "learner.js"
+# Node requires it by path: the file as the package ships it.
+LEARNER = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 RTOL = 1e-12
 
@@ -266,7 +269,7 @@ def test_normals_are_standard_normal(tmp_path):
 # --------------------------------------------------------------------------- stochastic parts
 SEEDS = 30
 #: (bound, empirical range, estimator, sigma): Chebyshev and Bernstein (e.r.), both estimators,
-#: two sigmas (issue 12), every combination: ``python tests/test_learner_js.py`` (about 6 CPU minutes).
+#: two sigmas, every combination: ``python tests/test_learner_js.py`` (about 6 CPU minutes).
 STAT_CONFIGS = [(b, er, est, s) for b, er in (("chebyshev", False), ("bernstein", True))
                 for est in ("gpomdp", "reinforce") for s in (1.0, 0.5)]
 #: What the test suite runs: half of them, a 2^(3-1) design in which each bound meets each
@@ -320,7 +323,7 @@ def test_runs_agree_statistically(bound, er, estimator, sigma):
         assert row["inside"], row
 
 
-if __name__ == "__main__":  # the agreement table of issue 12 (about 6 CPU minutes)
+if __name__ == "__main__":  # the agreement table of benchmarks/js_learner_agreement.md (about 6 CPU minutes)
     print("| bound | estimator | sigma | metric | JS (30 seeds) | safepg (30 seeds) | difference "
           "| 99% CI half-width | inside |")
     print("|---|---|---|---|---|---|---|---|---|")
