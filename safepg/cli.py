@@ -1,5 +1,7 @@
-"""Command line: ``python -m safepg learn ...`` (the method) and ``list``, ``run``, ``report``
-(the thesis's experiments). The top of both layers: nothing imports it but ``__main__``."""
+"""Command line: ``python -m safepg learn ...`` (and the experiment commands)."""
+
+# The top of both layers: ``learn`` runs the method, ``list``/``run``/``report`` the thesis's
+# experiments. Nothing imports this module but ``__main__``.
 
 from __future__ import annotations
 
