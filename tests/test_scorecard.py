@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from safepg.thesis import scorecard as sc
 from safepg import theory
+from safepg.thesis import errata
+from safepg.thesis import scorecard as sc
 from safepg.thesis.experiments import get_experiment, scaled
 
 BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2d", "cartpole", "errata"}
@@ -159,9 +160,9 @@ def test_cartpole_table_is_settled_by_the_sweep(rows):
 
 def test_theory_rows_follow_safepg_theory(rows):
     ids = by_id(rows)
-    for v in theory.verified():
+    for v in errata.verified():
         assert ids[f"theory/{v.id}"].status == "reproduced", v.id
-    for e in theory.errata():
+    for e in errata.errata():
         if e.kind in ("reference", "proof"):
             assert f"theory/{e.id}" not in ids
         else:

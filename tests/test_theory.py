@@ -13,6 +13,7 @@ import safepg.theory as T
 from safepg import meta
 from safepg.bounds import ErrorBound, gradient_range_bound, hoeffding, reinforce_variance_factor
 from safepg.constants import TaskConstants
+from safepg.thesis import errata
 
 S17 = sp.sqrt(17)
 pos = st.floats(min_value=1e-2, max_value=1e2, allow_nan=False)
@@ -100,7 +101,7 @@ def test_no_diagonal_step_beats_the_coordinate_step(grad, lam, c):
 
 # --------------------------------------------------------------------------- Theorem 4.3.2
 def test_theorem_4_3_2_matches_printed_where_printed_is_right():
-    t, p = T.theorem_4_3_2(), T.printed_theorem_4_3_2()
+    t, p = T.theorem_4_3_2(), errata.printed_theorem_4_3_2()
     assert eq(t["N_0"], p["N_0"])
     assert eq(t["N_star"], p["N_star"])
     assert eq(t["alpha_star"], p["alpha_star"])
@@ -119,7 +120,7 @@ def test_theorem_4_3_2_derivative_factors():
 
 
 def test_theorem_4_3_2_printed_upsilon_star_and_improvement_miss_4c():
-    t, p = T.theorem_4_3_2(), T.printed_theorem_4_3_2()
+    t, p = T.theorem_4_3_2(), errata.printed_theorem_4_3_2()
     assert eq(t["upsilon_star"], (4977 - 1207 * S17) * T.g**4 / (128 * T.c * T.d**2))
     assert eq(t["improvement_star"], (393 - 95 * S17) * T.g**2 / (32 * T.c))
     assert eq(p["upsilon_star"] / t["upsilon_star"], 4 * T.c)
@@ -131,7 +132,7 @@ def test_theorem_4_3_2_printed_upsilon_star_and_improvement_miss_4c():
 
 
 def test_theorem_4_3_2_garbled_upsilon_pinned():
-    t, p = T.theorem_4_3_2(), T.printed_theorem_4_3_2()
+    t, p = T.theorem_4_3_2(), errata.printed_theorem_4_3_2()
     point = {T.g: 1, T.d: 1, T.c: 1, T.N: 4}
     assert sp.nsimplify(t["upsilon"].subs(point)) == sp.Rational(1, 576)
     assert sp.nsimplify(p["upsilon_proof"].subs(point)) == sp.Rational(2401, 102400)
@@ -313,7 +314,7 @@ EXPECTED_ERRATA = {
 
 
 def test_errata_records():
-    errs = T.ERRATA
+    errs = errata.ERRATA
     ids = [e.id for e in errs]
     assert len(ids) == len(set(ids))
     assert set(ids) == EXPECTED_ERRATA
@@ -327,7 +328,7 @@ def test_errata_records():
 
 
 def test_verified_records():
-    recs = T.VERIFIED
+    recs = errata.VERIFIED
     ids = [v.id for v in recs]
     assert len(ids) == len(set(ids))
     n_equal = 0

@@ -185,7 +185,7 @@ def with_labels(rows: Sequence[dict[str, Any]], suffix: str = "") -> list[dict[s
 
 
 def errata_markdown(entries: Sequence[Any]) -> Markdown:
-    """The errata as Markdown, one section per entry (``safepg.theory.errata()``): where,
+    """The errata as Markdown, one section per entry (``safepg.thesis.errata.errata()``): where,
     why, the printed and the corrected statement, what corrected minus printed simplifies
     to (when both are expressions), and whether the experiments are affected.
 

@@ -9,8 +9,8 @@ One :class:`Row` per printed result, built from the same sources the chapters us
 * the closed forms of :class:`safepg.envs.lqg.LQG` (:math:`\theta^*`, :math:`J(\theta^*)`)
   with the printed values of :mod:`safepg.thesis.lqg_settings` and :data:`PRINTED`;
 * the printed statements of Chapters 3-4 and the appendices against their sympy
-  derivations, as recorded by :func:`safepg.theory.verified` and
-  :func:`safepg.theory.errata`.
+  derivations, as recorded by :func:`safepg.thesis.errata.verified` and
+  :func:`safepg.thesis.errata.errata`.
 
 No number is typed here except the printed values no other module records yet
 (:data:`PRINTED`). Each row gets a status by a stated rule (:data:`RULES`):
@@ -32,6 +32,7 @@ import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields
 from functools import cache
+from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
@@ -40,6 +41,8 @@ import sympy as sp
 
 from safepg import theory
 from safepg.envs.lqg import LQG
+from safepg.learning import LearningRecord
+from safepg.thesis import errata
 from safepg.thesis.experiments import (
     EXPERIMENTS,
     LQG2D_GAMMA,
@@ -50,7 +53,6 @@ from safepg.thesis.experiments import (
     report,
     run_experiment,
 )
-from safepg.learning import LearningRecord
 from safepg.thesis.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
 
 Status = Literal["reproduced", "differs (explained)", "open"]
@@ -61,7 +63,7 @@ STATUSES: tuple[Status, ...] = ("reproduced", "differs (explained)", "open")
 GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5.2", "Section 5.3")
 
 #: Printed values that no other module records (the others come from the experiments'
-#: ``thesis`` dicts, :mod:`safepg.thesis.lqg_settings` and :mod:`safepg.theory`). Strings keep the
+#: ``thesis`` dicts, :mod:`safepg.thesis.lqg_settings` and :mod:`safepg.thesis.errata`). Strings keep the
 #: printed digits, which set the rounding tolerance.
 PRINTED: dict[str, Any] = {
     # Section 5.1: "theta* ~ -0.59, corresponding to expected performance J(theta*) ~ -13.21".
@@ -173,7 +175,7 @@ NOTES: dict[str, Note] = {
     "section-5.3/components": Note(
         "Open: ours also moves {extra} (by at most {extra_move:.0e}); the thesis's constants, which decide "
         "which component is updated, are not given.", "cartpole", "Table 5.4", explains=False),
-    # Errata rows carry their own sentence (safepg.theory.errata()); this gives their link.
+    # Errata rows carry their own sentence (safepg.thesis.errata.errata()); this gives their link.
     "theory/erratum": Note("", "errata", "Errata"),
 }
 
@@ -317,7 +319,8 @@ def order_of_magnitude(x: float) -> int:
 
 
 # ------------------------------------------------------------------ links
-BOOK = Path(__file__).resolve().parents[1] / "book"
+# The book sits beside the top-level package: as many levels up as this module's dotted name is deep.
+BOOK = Path(__file__).resolve().parents[__name__.count(".")] / "book"
 
 
 def _heading_id(text: str) -> str:
@@ -487,7 +490,7 @@ _THEORY_LINKS: tuple[tuple[str, str, str], ...] = (
 )
 
 
-#: Short names of the statements of :mod:`safepg.theory` (display only; a new record falls
+#: Short names of the statements of :mod:`safepg.thesis.errata` (display only; a new record falls
 #: back to its id).
 THEORY_LABELS = {
     "thm_4_2_3_c": "penalty constant c", "cor_4_2_4_alpha": "step size 1/(2c)",
@@ -525,7 +528,7 @@ def _theory_link(location: str) -> tuple[str, str]:
 
 def _theory_rows(b: _Builder) -> None:
     """Chapters 3-4 and the appendices: printed statements against their derivations."""
-    for v in theory.verified():
+    for v in errata.verified():
         printed, derived = v.printed, v.derived
         if v.relation == "equal" and isinstance(printed, sp.Basic) and isinstance(derived, sp.Basic):
             ok = sp.simplify(printed - derived) == 0
@@ -534,14 +537,14 @@ def _theory_rows(b: _Builder) -> None:
             ratio = sp.simplify(derived / printed)
             ok = not ratio.free_symbols
             diff = f"ours / printed = {_expr_text(ratio)}"
-        else:  # "supports": the derivation proves the printed claim (safepg.theory says how)
+        else:  # "supports": the derivation proves the printed claim (its method says how)
             ok, diff = True, "proved"
         page, heading = _theory_link(v.location)
         b.add(id=f"theory/{v.id}", group=_theory_group(v.location), quantity=THEORY_LABELS.get(v.id, v.id),
               where=v.location, thesis=_expr_text(printed), ours=_expr_text(derived), difference=diff, ok=ok,
               rule="closed-form", page=page, heading=heading, thesis_tex=_expr_tex(printed),
               ours_tex=_expr_tex(derived), explanation="" if ok else f"Checked by: {v.method}.")
-    for e in theory.errata():
+    for e in errata.errata():
         if e.kind in ("reference", "proof"):  # cross-reference typos and proof steps are not results
             continue
         printed, corrected = e.printed, e.corrected
@@ -556,7 +559,7 @@ def _theory_rows(b: _Builder) -> None:
               ok=False, rule="closed-form", page="errata", heading="Errata", note_id="theory/erratum",
               explanation=first, thesis_tex=_expr_tex(printed), ours_tex=_expr_tex(corrected))
     # The decimal the thesis prints for the guarantee's constant, (393 - 95 sqrt 17) / 8 >= 0.16.
-    printed_coeff = sp.simplify(theory.printed_theorem_4_3_2()["improvement_star"] / theory.g**2)
+    printed_coeff = sp.simplify(errata.printed_theorem_4_3_2()["improvement_star"] / theory.g**2)
     value = float(printed_coeff)
     text = PRINTED["thm_4_3_2_decimal"]
     b.add(id="theory/thm_4_3_2_decimal", group=GROUPS[0], quantity="decimal value of (393 - 95√17)/8",
@@ -1016,44 +1019,13 @@ def read_csv(path: Path | str) -> list[dict[str, str]]:
 # at an edge that has more columns behind it, drawn by background layers that scroll with
 # the content (the covers) over layers that stay put (the shadows). In the dark theme the
 # book draws HTML outputs on a light card; the :has() rule gives ours the page's colours.
-_CSS = """
-<style>
-html[data-theme] .bd-content div.cell_output div.output.text_html:has(> .sc-out){background:transparent;
-  color:inherit;padding:0;border:0}
-.sc-out{--sc-bg:var(--pst-color-background,#fff);--sc-shadow:rgba(0,0,0,.28);
-  color:var(--pst-color-text-base,#222);background:var(--sc-bg)}
-html[data-theme=dark] .sc-out{--sc-shadow:rgba(255,255,255,.3)}
-.sc-scroll{max-width:100%;overflow-x:auto;-webkit-overflow-scrolling:touch;margin:.3em 0 1em;
-  border:1px solid var(--pst-color-border,#ccc);border-radius:4px;background-color:var(--sc-bg);
-  background-image:linear-gradient(to right,var(--sc-bg) 30%,transparent),
-   linear-gradient(to left,var(--sc-bg) 30%,transparent),
-   radial-gradient(farthest-side at 0 50%,var(--sc-shadow),transparent),
-   radial-gradient(farthest-side at 100% 50%,var(--sc-shadow),transparent);
-  background-position:0 0,100% 0,0 0,100% 0;background-repeat:no-repeat;
-  background-size:40px 100%,40px 100%,14px 100%,14px 100%;background-attachment:local,local,scroll,scroll}
-.sc-scroll:focus-visible{outline:2px solid var(--pst-color-primary,#0a7)}
-.sc-hint{font-size:.85em;color:var(--pst-color-text-muted,#555);margin:.2em 0}
-table.sc-table{border-collapse:collapse;font-size:.85em;margin:0;width:100%;background:transparent;
-  color:inherit}
-table.sc-table caption{caption-side:top;text-align:left;padding:.3em .5em;font-weight:600;color:inherit}
-table.sc-table th,table.sc-table td{border-top:1px solid var(--pst-color-border,#ddd);padding:.3em .5em;
-  vertical-align:top;text-align:left;background:transparent;color:inherit}
-table.sc-table tr.sc-note td{border-top:0;padding-top:0;font-size:.95em;color:var(--pst-color-text-muted,#555)}
-/* Notes and captions span the whole (wide) table: keep them readable in the visible part. */
-.sc-pin{position:sticky;left:.5em;max-width:min(44em,calc(100vw - 3.5rem))}
-table.sc-table td.sc-num{white-space:nowrap;font-variant-numeric:tabular-nums}
-table.sc-table td.sc-result{min-width:11em;max-width:20em}
-table.sc-table td.sc-words{min-width:12em;max-width:20em;overflow-wrap:anywhere}
-table.sc-table td.sc-expr{min-width:8em}
-.sc-math{max-width:20em;overflow-x:auto;overflow-y:hidden;padding-bottom:2px}
-.sc-detail{display:block;font-size:.85em;color:var(--pst-color-text-muted,#555)}
-.sc-status{display:inline-block;padding:0 .45em;border-radius:.7em;font-size:.9em;white-space:nowrap;
-  border:1px solid currentColor;font-weight:600}
-.sc-reproduced{color:#1a7f37}.sc-explained{color:#8a5a00}.sc-open{color:#c4111b}
-html[data-theme=dark] .sc-reproduced{color:#56d364}html[data-theme=dark] .sc-explained{color:#e3b341}
-html[data-theme=dark] .sc-open{color:#ff8b82}
-</style>
-"""
+@cache
+def _style_sheet() -> str:
+    """The scorecard tables' style sheet, ``safepg/thesis/static/scorecard.css``, as a
+    ``<style>`` element (read once per process through :mod:`importlib.resources`)."""
+    css = resources.files("safepg.thesis").joinpath("static", "scorecard.css").read_text(encoding="utf-8")
+    return f"\n<style>\n{css}</style>\n"
+
 
 _STATUS_CLASS = {"reproduced": "sc-reproduced", "differs (explained)": "sc-explained", "open": "sc-open"}
 _HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
@@ -1067,7 +1039,7 @@ def _status_html(status: str) -> str:
 def _wrap(table: str, css: bool, label: str) -> str:
     box = (f'<div class="sc-scroll" tabindex="0" role="region" aria-label="{html.escape(label)} (scrolls sideways)">'
            f"{table}</div>")
-    return f'{_CSS if css else ""}<div class="sc-out">{_HINT}{box}</div>'
+    return f'{_style_sheet() if css else ""}<div class="sc-out">{_HINT}{box}</div>'
 
 
 def summary_html(rows: Sequence[Row], css: bool = True) -> str:
