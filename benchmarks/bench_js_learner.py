@@ -36,6 +36,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "js_learner_timings.json"
+LEARNER = ROOT / "safepg" / "thesis" / "explorers" / "static" / "learner.js"
 
 NODE_BENCH = r"""
 const L = require(process.argv[2]);
@@ -139,7 +140,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         script = Path(tmp) / "bench.js"
         script.write_text(NODE_BENCH)
-        js = json.loads(subprocess.run([node, str(script), str(ROOT / "safepg" / "static" / "learner.js"),
+        js = json.loads(subprocess.run([node, str(script), str(LEARNER),
                                         str(args.repeat)], capture_output=True, text=True, check=True).stdout)
     env = LQG.thesis_1d()
     policy = LinearGaussianPolicy([[-0.3]], 1.0)

@@ -1,7 +1,8 @@
 """The explorers' JavaScript closed forms against safepg, evaluated with Node.js.
 
-A fast check of every formula in ``LIB_JS`` over many parameter values; the browser
-test then checks the same code running inside the built page.
+A fast check of every formula in ``static/lib.js`` over many parameter values; the browser
+test then checks the same code running inside the built page. Every JavaScript file the
+explorers ship parses.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import json
 import math
 import shutil
 import subprocess
+from importlib import resources
 
 import numpy as np
 import pytest
@@ -25,7 +27,6 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.thesis.explorers.component import LIB_JS
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -35,15 +36,31 @@ from safepg.meta import (
     penalty_constant,
     upsilon,
 )
+from safepg.thesis.explorers.component import static_text
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 
 
 def run_js(expr_cases: list[str]) -> list:
-    script = LIB_JS + "\nconsole.log(JSON.stringify([" + ",".join(expr_cases) + "]));"
+    script = static_text("lib.js") + "\nconsole.log(JSON.stringify([" + ",".join(expr_cases) + "]));"
     out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
     return json.loads(out)
+
+
+
+def test_static_sources_parse(tmp_path):
+    static = resources.files("safepg.thesis.explorers").joinpath("static")
+    names = sorted(f.name for f in static.iterdir() if f.name.endswith(".js"))
+    assert {"lib.js", "runtime.js", "lqg_compute.js", "upsilon_compute.js", "live_page.js", "learner.js"} <= set(names)
+    for name in names:
+        src = static_text(name)
+        if name.endswith("_compute.js"):  # a function body: its top-level return needs the function
+            src = f"(function (p, data, lib) {{{src}}});"
+        path = tmp_path / name
+        path.write_text(src, encoding="utf-8")
+        proc = subprocess.run([NODE, "--check", str(path)], capture_output=True, text=True)
+        assert proc.returncode == 0, (name, proc.stderr)
 
 
 def test_lqg_closed_form():

@@ -1,4 +1,4 @@
-"""The explorers' axis ticks (``safepgTicks``, ``safepgTickLabels`` in safepg/thesis/explorers/component.py),
+"""The explorers' axis ticks (``safepgTicks``, ``safepgTickLabels`` in safepg/thesis/explorers/static/runtime.js),
 evaluated with Node.js: every label distinct, and as short as that allows.
 
 The browser test (test_browser_book.py) checks the drawn labels stay inside each plot.
@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from safepg.thesis.explorers.component import _RUNTIME_JS
+from safepg.thesis.explorers.component import static_text
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
@@ -20,7 +20,7 @@ pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 
 def axis(lo: float, hi: float, log: bool) -> tuple[list[float], list[str]]:
     """Tick values and labels of an axis from lo to hi (for a log axis, lo and hi are log10)."""
-    script = (_RUNTIME_JS + f"\nconst t = safepgTicks({lo}, {hi}, {str(log).lower()});"
+    script = (static_text("runtime.js") + f"\nconst t = safepgTicks({lo}, {hi}, {str(log).lower()});"
               f"\nconsole.log(JSON.stringify([t, safepgTickLabels(t, {str(log).lower()})]));")
     out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
     ticks, labels = json.loads(out)

@@ -11,8 +11,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from safepg.thesis.experiments import get_experiment, t52_name
 from safepg.learning import LearningRecord
+from safepg.thesis.experiments import get_experiment, t52_name
 from safepg.thesis.explorers.live_learner import BUDGETS, learner_js, live_batch_size_explorer, task_data
 
 

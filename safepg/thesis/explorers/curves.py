@@ -1,7 +1,8 @@
 """The book's explorers, built on :class:`safepg.thesis.explorers.component.Explorer`.
 
 Each factory returns an explorer whose JavaScript and Python halves compute the same
-curves: closed forms in both, precomputed Monte Carlo quantities embedded as data.
+curves: closed forms in both, precomputed Monte Carlo quantities embedded as data. The
+JavaScript halves are ``static/lqg_compute.js`` and ``static/upsilon_compute.js``.
 The batch-size explorer, which reruns Algorithm 4.1 in the page, is
 :func:`safepg.thesis.explorers.live_learner.live_batch_size_explorer`.
 """
@@ -13,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from safepg.thesis import plotting
 from safepg.bounds import (
     ErrorBound,
     bernstein,
@@ -25,7 +25,6 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -35,29 +34,18 @@ from safepg.meta import (
     penalty_constant,
     upsilon,
 )
+from safepg.thesis import plotting
+from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
+
+
+def _compute_js(name: str) -> str:
+    """The body of a compute function, from ``static/name``, starting on the line after
+    ``function(p,data,lib){`` in the page (the newline is part of the body, so of the
+    explorer's id)."""
+    return "\n" + static_text(name)
+
 
 # ---------------------------------------------------------------------------- LQG
-_LQG_JS = r"""
-const th = lib.linspace(data.theta_min, data.theta_max, data.points);
-const J = th.map(t => lib.lqgJ(t, p.sigma, data.gamma, data.b));
-const js = lib.lqgJ(data.theta_star, p.sigma, data.gamma, data.b);
-const interp = (xs, ys, x) => { let i = 1; while (i < xs.length - 1 && xs[i] < x) i++;
-  const w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]); return ys[i - 1] + w * (ys[i] - ys[i - 1]); };
-const vr = interp(data.sigmas, data.var_reinforce, p.sigma), vg = interp(data.sigmas, data.var_gpomdp, p.sigma);
-return {
-  plots: {
-    J: {series: [{label: "J(theta), sigma = " + p.sigma, x: th, y: J, color: data.accent}],
-        markers: [{x: data.theta_star, y: js, label: "theta*", color: data.accent}]},
-    var: {series: [{label: "REINFORCE", x: data.sigmas, y: data.var_reinforce, color: data.c_rf, dash: true},
-                   {label: "G(PO)MDP", x: data.sigmas, y: data.var_gpomdp, color: data.c_gp}],
-          markers: [{x: p.sigma, y: vr, color: data.c_rf}, {x: p.sigma, y: vg, color: data.c_gp}]},
-  },
-  values: {J_star: js, var_reinforce: vr, var_gpomdp: vg},
-  text: `J(theta*) = ${js.toFixed(3)} at theta* = ${data.theta_star.toFixed(4)}; per-trajectory variance at theta = ${data.theta_var}: REINFORCE ${vr.toFixed(1)}, G(PO)MDP ${vg.toFixed(1)}`,
-};
-"""
-
-
 def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_var: float = -0.3,
                  seed: int = 0) -> Explorer:
     """1-D LQG: the closed-form J(theta) as sigma moves (theta* marked), beside the
@@ -91,7 +79,7 @@ def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_v
         [Slider("sigma", "policy std sigma", 0.2, 2.0, 0.05, 1.0)],
         [Plot("J", "theta", "J(theta)", ymin=-120, ymax=0),
          Plot("var", "sigma", "per-trajectory variance", ylog=True)],
-        _LQG_JS, compute_py, data)
+        _compute_js("lqg_compute.js"), compute_py, data)
 
 
 # ------------------------------------------------------------------------ Upsilon
@@ -103,33 +91,6 @@ BOUND_CHOICES = (
     ("bernstein", "Bernstein, Lemma 4.3.3 range"),
     ("bernstein-er", "Bernstein, empirical range"),
 )
-
-_UPSILON_JS = r"""
-const k = {R: data.R, M: data.M, Avol: data.Avol, Abar: data.Abar, gamma: data.gamma, H: data.H, sigma: p.sigma};
-const c = lib.penalty(k), g = p.g;
-const interp = (xs, ys, x) => { let i = 1; while (i < xs.length - 1 && xs[i] < x) i++;
-  const w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]); return ys[i - 1] + w * (ys[i] - ys[i - 1]); };
-const S = interp(data.sigmas, data.sample_var, p.sigma), er = interp(data.sigmas, data.emp_range, p.sigma);
-let bd;
-if (p.bound === "chebyshev-gpomdp") bd = lib.chebyshev(p.delta, lib.varGpomdp(k));
-else if (p.bound === "chebyshev-reinforce") bd = lib.chebyshev(p.delta, lib.varReinforce(k));
-else if (p.bound === "hoeffding") bd = lib.hoeffding(p.delta, lib.rangeBound(k));
-else if (p.bound === "hoeffding-er") bd = lib.hoeffding(p.delta, er);
-else if (p.bound === "bernstein") bd = lib.bernstein(p.delta, S, lib.rangeBound(k));
-else bd = lib.bernstein(p.delta, S, er);
-const n0 = lib.nZero(g, bd), ns = lib.nStar(g, bd, c);
-const N = lib.geomspace(Math.max(1, n0), 6 * ns, data.points);
-const U = N.map(n => lib.upsilon(n, g, bd, c));
-const e = lib.eps(bd, ns), a = lib.step(g, e, c), imp = lib.improvement(g, e, c);
-return {
-  plots: {U: {series: [{label: "Upsilon(N)", x: N, y: U, color: data.accent}],
-              markers: [{x: n0, y: 0, label: "N0", color: data.muted},
-                        {x: ns, y: lib.upsilon(ns, g, bd, c), label: "N*", color: data.accent}]}},
-  values: {c: c, d: bd.d, f: bd.f, N0: n0, Nstar: ns, alpha: a, improvement: imp},
-  text: `c = ${c.toPrecision(5)}, d = ${bd.d.toPrecision(5)}, f = ${bd.f.toPrecision(5)}<br>` +
-        `N0 = ${n0.toFixed(1)}, N* = ${ns}, step alpha* = ${a.toExponential(4)}, guaranteed improvement = ${imp.toExponential(4)}`,
-};
-"""
 
 
 def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta: float = 0.0,
@@ -182,4 +143,4 @@ def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, the
          Slider("g", "||g||_inf", 1.0, 60.0, 1.0, 30.0),
          Select("bound", "bound", BOUND_CHOICES, "bernstein-er")],
         [Plot("U", "batch size N", "Upsilon_delta(N)", xlog=True)],
-        _UPSILON_JS, compute_py, data)
+        _compute_js("upsilon_compute.js"), compute_py, data)

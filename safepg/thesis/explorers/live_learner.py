@@ -1,7 +1,8 @@
 r"""The live batch-size explorer: Algorithm 4.1 reruns in the reader's browser.
 
 :func:`live_batch_size_explorer` returns an :class:`~safepg.thesis.explorers.component.Explorer` whose page
-half runs the JavaScript learner ``safepg/thesis/explorers/static/learner.js`` (Algorithm 4.1 and vanilla
+half (``static/live_page.js``, with the component's ``static/runtime.js``) runs the JavaScript
+learner ``safepg/thesis/explorers/static/learner.js`` (Algorithm 4.1 and vanilla
 policy gradient on ``LQG.thesis_1d()``, the same algorithm as :mod:`safepg.learning`) in
 a Web Worker created from an inline Blob, so it needs no kernel, no network and no file
 beside the page (it works from ``file://``). Every control move cancels the running
@@ -25,18 +26,16 @@ import hashlib
 import html
 import json
 from collections.abc import Mapping, Sequence
-from functools import lru_cache
-from importlib import resources
 from typing import Any
 
 import numpy as np
 
 from safepg import portable
+from safepg.envs.lqg import LQG
+from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band, performance_on_grid
-from safepg.envs.lqg import LQG
-from safepg.thesis.explorers.component import _RUNTIME_JS, Explorer, Plot, Select, Slider
-from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
 BUDGETS = (10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000)
@@ -50,10 +49,9 @@ BOUND_CHOICES = (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"), ("hoeff
 TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in your browser"
 
 
-@lru_cache(maxsize=1)
 def learner_js() -> str:
     """The JavaScript learner shipped in the package (``safepg/thesis/explorers/static/learner.js``)."""
-    return resources.files("safepg").joinpath("static/learner.js").read_text(encoding="utf-8")
+    return static_text("learner.js")
 
 
 def _round(values: Any, digits: int = DIGITS) -> list[float | None]:
@@ -144,214 +142,15 @@ class LiveLearnerExplorer(Explorer):
             '<div class="safepg-status" style="font-size:0.85em;opacity:0.8;margin:0.2em 0"></div>'
             f'{self._plots_html()}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
-            f"<script>(function(){{{_RUNTIME_JS}{_LIVE_JS}"
+            # The page half (static/live_page.js) draws with the runtime's safepgPlot; the learner
+            # travels as a string so the worker can be built from a Blob (no file, no network).
+            f'<script>(function(){{\n{static_text("runtime.js")}\n{static_text("live_page.js")}'
             f"const spec={spec};const learnerSrc={learner};"
             f'safepgLiveLearner(document.getElementById("{uid}"),spec,learnerSrc);}})();</script></div>'
         )
 
     def __repr__(self) -> str:
         return f"LiveLearnerExplorer({self.title!r})"
-
-
-# The page half. safepgPlot and safepgTicks come from safepg.thesis.explorers.component's runtime; the
-# learner source is a string so the worker can be built from a Blob (no file, no network).
-_LIVE_JS = r"""
-const SAFEPG_WORKER_GLUE = `
-self.onmessage = function (e) {
-  const msg = e.data;
-  try {
-    const driver = new safepgLearner.Driver(msg);
-    let first = true;
-    while (!driver.done) {
-      const parts = driver.advance(first ? 15 : msg.every);
-      first = false;
-      self.postMessage({type: driver.done ? "done" : "progress", job: msg.job, parts: parts});
-    }
-  } catch (err) {
-    self.postMessage({type: "error", job: msg.job, message: String((err && err.message) || err)});
-  }
-};`;
-function safepgLiveThin(n, points) {
-  if (n <= points) { const o = []; for (let i = 0; i < n; i++) o.push(i); return o; }
-  const o = [];
-  for (let i = 0; i < points; i++) {
-    const k = Math.floor(i * (n - 1) / (points - 1) + 0.5);
-    if (!o.length || o[o.length - 1] !== k) o.push(k);
-  }
-  return o;
-}
-function safepgLiveSummary(r) {
-  // safepg.learning.LearningRecord's summary of a (possibly partial) record.
-  const I = r.batchSize.length;
-  let tot = 0, w = 0, up = 0;
-  for (let i = 0; i < I; i++) {
-    tot += r.batchSize[i]; w += r.batchSize[i] * r.Jhat[i];
-    if (r.J[i + 1] - r.J[i] >= 0) up++;
-  }
-  const Jat = {};
-  let end = 0, i = 0;
-  for (const T of [100000, 1000000, 3000000]) {
-    if (T > tot) continue;
-    while (end + r.batchSize[i] < T) { end += r.batchSize[i]; i++; }
-    Jat[String(T)] = r.J[i];
-  }
-  return {iterations: I, trajectories: tot, upsilon_bar: I ? w / tot : null, improvement_ratio: I ? up / I : null,
-          J_final: r.J[I], theta_final: r.theta[I], J_at: Jat, first_batches: r.batchSize.slice(0, 3),
-          done: r.done, diverged: r.diverged};
-}
-function safepgLiveResult(p, st, data) {
-  // The same structure as compute_py: plots (series), values, text.
-  const plots = {N: {series: []}, J: {series: []}, alpha: {series: []}};
-  const values = {done: st.done, worker: st.worker, elapsed_ms: st.elapsed, run_ms: {}};
-  const key = `${p.estimator}-${p.bound}-delta=${+p.delta}-${p.score}`;
-  const run = (p.sigma === 1 && p.baseline === "on") ? data.runs[key] : undefined;
-  const B = +p.budget;
-  if (run) {
-    const its = [], ns = [], as = [];
-    for (let i = 0; i < run.iteration.length; i++) {
-      if (run.start[i] === null || run.start[i] >= B) break;
-      its.push(run.iteration[i]); ns.push(run.batch_size[i]); as.push(run.alpha[i]);
-    }
-    const gx = [], gy = [];
-    for (let i = 0; i < data.grid.length && data.grid[i] <= B; i++) { gx.push(data.grid[i]); gy.push(run.J[i]); }
-    const label = `stored safepg run (${run.seeds} seed${run.seeds === 1 ? "" : "s"})`;
-    const thin = {color: data.muted, dash: true};
-    plots.N.series.push({label: label, x: its, y: ns, ...thin});
-    plots.J.series.push({label: label, x: gx, y: gy, ...thin});
-    plots.alpha.series.push({label: label, x: its, y: as, ...thin});
-    values.thesis = {found: true, key: key, name: run.name, ...run.budgets[String(B)]};
-  } else values.thesis = {found: false, key: key};
-  for (const name of ["adaptive", "vanilla"]) {
-    const r = st.runs[name];
-    if (!r) { values[name] = null; continue; }
-    const I = r.batchSize.length;
-    const style = name === "adaptive" ? {color: data.colors[p.bound], dash: p.estimator === "reinforce"}
-                                      : {color: data.vanilla_color, dash: false};
-    const label = name === "adaptive" ? "Algorithm 4.1 (live)"
-                                      : `vanilla, N = ${p.vanilla_n}, alpha = ${p.vanilla_alpha}`;
-    const keep = safepgLiveThin(I, data.points);
-    plots.N.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.batchSize[i]), ...style});
-    plots.alpha.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.alpha[i]), ...style});
-    // J of the policy that generated trajectory T (Figures 5.1-5.2), on a grid of T.
-    const gx = [], gy = [];
-    let end = 0, i = 0;
-    for (let k = 0; k < data.points; k++) {
-      const T = Math.max(1, Math.round(1 + k * (B - 1) / (data.points - 1)));
-      if (T > r.used) break;
-      while (i < I && end + r.batchSize[i] < T) { end += r.batchSize[i]; i++; }
-      gx.push(T); gy.push(r.J[Math.min(i, I)]);
-    }
-    plots.J.series.push({label: label, x: gx, y: gy, ...style});
-    values[name] = safepgLiveSummary(r);
-    values.run_ms[name] = r.ms;
-  }
-  const f = (v, d) => (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d);
-  const line = (name, v) => v ? `${name}: ${v.iterations} iterations, ${v.trajectories} trajectories, ` +
-    `Upsilon-bar ${f(v.upsilon_bar, 4)}, improvement ratio ${f(100 * v.improvement_ratio, 2)}%, ` +
-    `J ${f(v.J_final, 3)} at theta ${f(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}` : "";
-  let text = line("Algorithm 4.1", values.adaptive);
-  if (values.vanilla) text += "<br>" + line("vanilla PG", values.vanilla);
-  text += "<br>" + (values.thesis.found
-    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ` +
-      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${f(values.thesis.upsilon_bar, 4)}`
-    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, " +
-      "delta in {0.05, 0.25, 0.5, 0.75, 0.95})");
-  return {plots: plots, values: values, text: text};
-}
-function safepgLiveLearner(root, spec, learnerSrc) {
-  const inputs = root.querySelectorAll("[data-param]");
-  const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
-  const data = spec.data;
-  let url = null, worker = null, job = 0, st = null, pending = false, local = null;
-  try { url = URL.createObjectURL(new Blob([learnerSrc, SAFEPG_WORKER_GLUE], {type: "text/javascript"})); }
-  catch (e) { url = null; }
-  function params() {
-    const p = {};
-    inputs.forEach(inp => { p[inp.dataset.param] = inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value); });
-    return p;
-  }
-  function configs(p) {
-    const common = {sigma: p.sigma, estimator: p.estimator, baseline: p.baseline === "on", score: p.score,
-                    budget: +p.budget, seed: Math.round(p.seed), theta0: 0};
-    const b = p.bound.replace("-er", "");
-    const runs = [{name: "adaptive", cfg: {...common, algorithm: "adaptive", bound: b, delta: p.delta,
-                                           empiricalRange: p.bound.endsWith("-er"), nMin: 100, nMax: 500000,
-                                           stream: 0}}];
-    if (p.vanilla_n !== "off")
-      runs.push({name: "vanilla", cfg: {...common, algorithm: "vanilla", batchSize: +p.vanilla_n,
-                                        alpha: +p.vanilla_alpha, stream: 1}});
-    return runs;
-  }
-  function draw() {
-    pending = false;
-    const res = safepgLiveResult(st.p, st, data);
-    for (const plot of spec.plots)
-      safepgPlot(root.querySelector(`svg[data-plot="${plot.id}"]`), plot, res.plots[plot.id]);
-    root.querySelector(".safepg-text").innerHTML = res.text;
-    const a = st.runs.adaptive;
-    statusEl.textContent = st.error ? `error: ${st.error}` : st.done
-      ? `done in ${(st.elapsed / 1000).toFixed(2)} s (${st.worker ? "Web Worker" : "page thread"})`
-      : `running: ${a ? a.used : 0} of ${st.p.budget} trajectories...`;
-    valuesEl.textContent = JSON.stringify({params: st.p, job: st.job, result: res});
-  }
-  function schedule() { if (!pending) { pending = true; setTimeout(draw, 0); } }
-  function receive(msg) {
-    if (!st || msg.job !== st.job) return;  // a cancelled run's late message
-    if (msg.type === "error") { st.error = msg.message; st.done = true; schedule(); return; }
-    for (const part of msg.parts) {
-      let r = st.runs[part.name];
-      if (!r) r = st.runs[part.name] = {batchSize: [], alpha: [], eps: [], Jhat: [], grad: [],
-                                        theta: [part.theta0], J: [part.J0]};
-      for (const k of ["batchSize", "alpha", "eps", "Jhat", "grad", "theta", "J"])
-        for (const v of part[k]) r[k].push(v);
-      r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms;
-    }
-    st.elapsed = performance.now() - st.t0;
-    if (msg.type === "done") { st.done = true; if (worker) { worker.terminate(); worker = null; } }
-    schedule();
-  }
-  function runLocally(msg) {
-    // No Web Worker (a browser that refuses Blob workers): slices of the page's own thread.
-    const L = new Function(learnerSrc + "\nreturn safepgLearner;")();
-    const driver = new L.Driver(msg), mine = msg.job;
-    local = mine;
-    (function slice() {
-      if (local !== mine) return;  // cancelled by a newer run
-      const parts = driver.advance(25);
-      receive({type: driver.done ? "done" : "progress", job: mine, parts: parts});
-      if (!driver.done) setTimeout(slice, 0);
-    })();
-  }
-  function start() {
-    job += 1; local = null;
-    if (worker) { worker.terminate(); worker = null; }  // cancel the run in flight
-    const p = params();
-    inputs.forEach(inp => {
-      const out = root.querySelector(`[data-show="${inp.dataset.param}"]`);
-      if (out) out.textContent = inp.value;
-    });
-    const msg = {job: job, task: data.task, every: 150, runs: configs(p)};
-    st = {job: job, p: p, runs: {}, done: false, elapsed: 0, t0: performance.now(), worker: false, error: null};
-    if (url && typeof Worker !== "undefined") {
-      try {
-        worker = new Worker(url);
-        worker.onmessage = e => receive(e.data);
-        worker.onerror = e => {  // a browser that refuses Blob workers: run in the page instead
-          e.preventDefault();
-          if (worker) worker.terminate();
-          worker = null; st.worker = false;
-          runLocally(msg);
-        };
-        worker.postMessage(msg);
-        st.worker = true;
-      } catch (e) { worker = null; runLocally(msg); }
-    } else runLocally(msg);
-    draw();
-  }
-  inputs.forEach(inp => inp.addEventListener("input", start));
-  start();
-}
-"""
 
 
 def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | None = None,
