@@ -15,8 +15,8 @@ import numpy as np
 
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
-from safepg.stats import mean_ci95
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.stats import mean_ci95
 
 
 def digest(rec: LearningRecord) -> dict[str, object]:

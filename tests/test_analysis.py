@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from safepg.learning import LearningRecord
 from safepg.thesis.analysis import (
     by_iteration,
     markdown_table,
@@ -12,7 +13,6 @@ from safepg.thesis.analysis import (
     table_5_2,
     table_upsilon,
 )
-from safepg.learning import LearningRecord
 
 
 def rec(batch, J):
@@ -48,8 +48,8 @@ def test_table_5_2_differences():
 
 def test_simulated_gradient_matches_settings_value():
     # SETTINGS.md: at theta = -0.3 the finite difference of the simulated return is about -3.870.
-    from safepg.thesis.analysis import simulated_gradient, simulated_performance
     from safepg.envs.lqg import LQG
+    from safepg.thesis.analysis import simulated_gradient, simulated_performance
 
     env = LQG.thesis_1d()
     g = simulated_gradient(env, -0.3, 1.0, 200_000, seed=1)
@@ -58,8 +58,8 @@ def test_simulated_gradient_matches_settings_value():
 
 
 def test_gradient_estimates_share_batches_and_concentrate():
-    from safepg.thesis.analysis import gradient_estimates
     from safepg.envs.lqg import LQG
+    from safepg.thesis.analysis import gradient_estimates
 
     est = gradient_estimates(LQG.thesis_1d(), -0.3, 1.0, [100, 10_000], repeats=20, seed=0)
     assert est["gpomdp"].shape == (2, 20)
@@ -79,8 +79,8 @@ def test_improvement_ratio_on_other_objective():
 
 def test_simulated_objective_optimum_differs_from_closed_form():
     # SETTINGS.md: the clipped 20-step objective peaks near theta = -0.65 (J ~ -9.56), not -0.588.
-    from safepg.thesis.analysis import simulated_objective
     from safepg.envs.lqg import LQG
+    from safepg.thesis.analysis import simulated_objective
 
     f = simulated_objective(LQG.thesis_1d(), 1.0, -0.9, -0.4, points=26, n=100_000, seed=3)
     t = np.linspace(-0.9, -0.4, 2001)

@@ -9,6 +9,12 @@ import math
 import numpy as np
 import pytest
 
+from safepg.constants import TaskConstants
+from safepg.envs.cartpole import NORMALISED_SCALE, CartPole
+from safepg.estimators import gradient_samples
+from safepg.learning import LearningRecord
+from safepg.meta import penalty_constant
+from safepg.policies import LinearGaussianPolicy
 from safepg.thesis.cartpole_sweep import (
     CAN_MOVE_SHARE,
     LEARNS_MARGIN,
@@ -23,13 +29,7 @@ from safepg.thesis.cartpole_sweep import (
     sweep_summary,
     sweep_table,
 )
-from safepg.constants import TaskConstants
-from safepg.envs.cartpole import NORMALISED_SCALE, CartPole
-from safepg.estimators import gradient_samples
 from safepg.thesis.experiments import CARTPOLE_SWEEP, EXPERIMENTS, SWEEP_BUDGET, get_experiment, make_env
-from safepg.learning import LearningRecord
-from safepg.meta import penalty_constant
-from safepg.policies import LinearGaussianPolicy
 
 #: c of our default doubled-pole setting (R 1, M_phi 10, |A| 20, gamma 0.99, sigma 1), as the chapter prints it.
 DEFAULT_C = 57478845.60802851

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from safepg.envs.lqg import LQG
+from safepg.policies import LinearGaussianPolicy
 from safepg.thesis.lqg_settings import (
     FIXED_POINTS,
     PRINTED_J_STAR,
@@ -18,7 +19,6 @@ from safepg.thesis.lqg_settings import (
     search_printed_settings,
     second_moments,
 )
-from safepg.policies import LinearGaussianPolicy
 
 # A coupled task, so that a wrong transpose or a missing cross term shows.
 ENV = LQG(dim=2, gamma=0.9, horizon=15, A=np.array([[1.0, 0.1], [0.0, 0.9]]),

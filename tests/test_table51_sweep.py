@@ -5,11 +5,11 @@ import json
 import numpy as np
 import pytest
 
-from safepg.thesis import table51_sweep as ts
 from safepg.envs.lqg import LQG
 from safepg.estimators import trajectory_scores
-from safepg.thesis.experiments import T51_PRINTED
 from safepg.policies import LinearGaussianPolicy
+from safepg.thesis import table51_sweep as ts
+from safepg.thesis.experiments import T51_PRINTED
 
 ENV = LQG.thesis_1d()
 

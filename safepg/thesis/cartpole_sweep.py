@@ -32,6 +32,8 @@ import numpy as np
 from safepg import portable
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
+from safepg.learning import LearningRecord
+from safepg.meta import ALPHA_STAR_FACTOR, penalty_constant
 from safepg.thesis.experiments import (
     CARTPOLE_SWEEP,
     SWEEP_BUDGET,
@@ -41,8 +43,6 @@ from safepg.thesis.experiments import (
     make_env,
     run_experiment,
 )
-from safepg.learning import LearningRecord
-from safepg.meta import ALPHA_STAR_FACTOR, penalty_constant
 
 #: The thesis's printed numbers the sweep is held against (Section 5.3, Table 5.4).
 THESIS = {"baseline_iterations": 72, "adaptive_upsilon_bar": 193.12, "adaptive_improvement_ratio": 0.5301,

@@ -13,11 +13,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from safepg.thesis import plotting
-from safepg.thesis.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
 from safepg.bounds import ErrorBound
 from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
+from safepg.thesis import plotting
+from safepg.thesis.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
 
 Records = Mapping[str, Sequence[LearningRecord]]
 

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 from scipy import integrate
 
-from safepg.rng import RNGLike, as_generator
 from safepg.estimators import check_estimator
+from safepg.rng import RNGLike, as_generator
 
 __all__ = [
     "CheckResult",

@@ -54,8 +54,8 @@ from typing import Any, Literal
 import numpy as np
 from numba import njit
 
-from safepg.rng import RNGLike, as_generator
 from safepg.envs.lqg import LQG
+from safepg.rng import RNGLike, as_generator
 
 Baseline = Literal["none", "optimal", "average"]
 SigmaReading = Literal["std", "variance"]
