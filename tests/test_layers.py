@@ -26,10 +26,12 @@ ENTRY = f"{PACKAGE}.__main__"
 #: A module longer than this is split, or listed in :data:`LONG_MODULES`.
 MAX_LINES = 600
 #: Modules allowed over :data:`MAX_LINES`: ``{path relative to the repository: why it is one concept}``.
-#: Empty on purpose until the split of the package into its two layers is done; an entry is
-#: added only with the reason the module cannot be cut into smaller ones, and an entry whose
-#: module is gone or back under the limit fails the test.
-LONG_MODULES: dict[str, str] = {}
+#: An entry is added only with the reason the module cannot be cut into smaller ones, and an
+#: entry whose module is gone or back under the limit fails the test. DESIGN.md lists the same.
+LONG_MODULES: dict[str, str] = {
+    "safepg/envs/cartpole.py": "one task: the batched cart-pole and its gymnasium single-env form share one step "
+                               "function, the physical constants and the setting names",
+}
 
 
 def check_layers(tree: Tree) -> list[str]:
@@ -156,7 +158,7 @@ def test_probe_rules_fail(tmp_path: Path) -> None:
         "safepg/reach.py:1: safepg.reach imports the private module safepg.envs._kernel, private to safepg.envs",
         "safepg/reach.py:5: safepg.reach imports the private module safepg.envs._kernel, private to safepg.envs",
     ]
-    assert check_size(tree) == [f"safepg/huge.py:1: {MAX_LINES + 1} lines (> {MAX_LINES})"]
+    assert check_size(tree, allowed={}) == [f"safepg/huge.py:1: {MAX_LINES + 1} lines (> {MAX_LINES})"]
     assert check_size(tree, allowed={"safepg/huge.py": "one table", "safepg/gone.py": "split"}) == [
         "safepg/gone.py: in the allow-list but absent",
     ]
