@@ -1,4 +1,5 @@
-r"""The cart-pole sweep of issue 13: can the adaptive step move on the doubled pole at all?
+r"""The cart-pole sweep over the settings the thesis leaves unstated: can the adaptive step
+move on the doubled pole at all?
 
 In Section 5.3 the thesis reports that on the doubled pole the adaptive method (Algorithm
 4.1, G(PO)MDP, Bernstein with empirical range, delta = 0.95) learns more slowly than vanilla

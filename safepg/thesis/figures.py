@@ -215,7 +215,7 @@ def figure_estimator_variance(sigmas: np.ndarray, variance: Mapping[str, np.ndar
 
 
 def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) -> Figure:
-    """Cart-pole sweep (ours, issue 13): Upsilon-bar and improvement ratio of both methods per setting.
+    """Cart-pole sweep (ours): Upsilon-bar and improvement ratio of both methods per setting.
 
     ``rows`` are :func:`safepg.thesis.cartpole_sweep.sweep_table` rows (settings without a doubled-pole
     run are skipped), one per line from the top, labelled with the setting's penalty constant c;
@@ -259,7 +259,7 @@ def figure_cartpole_sweep(rows: Sequence[Mapping], thesis: Mapping[str, float]) 
 
 def figure_penalty_grid(rows: Sequence[Mapping], threshold_c: float | None = None,
                         ours: tuple[float, float] | None = None) -> Figure:
-    """Cart-pole sweep (ours, issue 13): the penalty constant c against gamma, analytically.
+    """Cart-pole sweep (ours): the penalty constant c against gamma, analytically.
 
     ``rows`` are :func:`safepg.thesis.cartpole_sweep.penalty_grid` rows. For each horizon term, the
     band spans every (M_phi, |A|) of the grid with R = 1; the line is its most favourable
