@@ -16,7 +16,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from layers import Tree, cycles, importer_violations, layer_violations, private_violations, scan, size_violations
+from layers import (
+    Tree,
+    cycles,
+    importer_violations,
+    layer_violations,
+    private_violations,
+    scan,
+    size_violations,
+    within,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = "safepg"
@@ -81,6 +90,17 @@ def test_no_import_cycles(tree: Tree) -> None:
 def test_no_private_imports(tree: Tree) -> None:
     found = private_violations(tree)
     assert not found, report("imports of private names or modules", found)
+
+
+def test_thesis_does_not_use_the_gym_adapter(tree: Tree) -> None:
+    """The reproduction runs on the thesis's own tasks; the gymnasium adapter shows the core
+    as a library and must not become something the printed numbers depend on."""
+    adapter = f"{PACKAGE}.envs.gym_task"
+    found = sorted(f"{tree.where(i.importer, i.line)}: {i.importer} imports {i.target}"
+                   + ("" if i.name is None else f".{i.name}")
+                   for i in tree.imports if within(i.importer, THESIS)
+                   and (within(i.target, adapter) or (i.target == f"{PACKAGE}.envs" and i.name == "GymTask")))
+    assert not found, report(f"imports of {adapter} by the thesis layer", found)
 
 
 def test_module_size(tree: Tree) -> None:
