@@ -21,6 +21,8 @@ from safepg import theory
 from safepg.thesis import errata
 from safepg.thesis import scorecard as sc
 from safepg.thesis.experiments import get_experiment, scaled
+from safepg.thesis.scorecard import links as sc_links
+from safepg.thesis.scorecard.builder import Builder
 
 BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2d", "cartpole", "errata"}
 
@@ -112,7 +114,7 @@ def test_every_rule_is_stated():
 def test_status_follows_rule_and_note(monkeypatch):
     monkeypatch.setitem(sc.NOTES, "x/explained", sc.Note("Because of {why}.", "lqg1d", "Table 5.1"))
     monkeypatch.setitem(sc.NOTES, "x/known", sc.Note("Open: {why}.", "lqg1d", "Table 5.2", explains=False))
-    b = sc._Builder()
+    b = Builder()
     b.values["why"] = "a reason"
     common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
                   rule="rounded", page="lqg2d", heading="Table 5.3")
@@ -245,7 +247,7 @@ def test_every_row_links_to_a_section_of_the_book(rows):
         page, anchor = m.groups()
         assert page in BOOK_PAGES, r.id
         assert anchor, f"{r.id} links to {page} without an anchor"
-        headings = [sc._heading_id(text) for _, text in sc._headings(page)]
+        headings = [sc_links.heading_id(text) for _, text in sc_links._headings(page)]
         assert anchor in headings, (r.id, r.link)
 
 

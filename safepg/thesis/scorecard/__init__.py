@@ -1,0 +1,80 @@
+r"""The reproduction scorecard: every quantitative result the thesis prints, ours beside it.
+
+One :class:`Row` per printed result, built from the same sources the chapters use:
+
+* the stored runs of the Chapter 5 experiments, summarised by
+  :func:`safepg.thesis.experiments.report` (every cell of Tables 5.1-5.4, the improvement ratios,
+  the final parameters of Section 5.2.1, the cart-pole baseline's iteration count), with
+  the printed values taken from each :class:`~safepg.thesis.experiments.Experiment`'s ``thesis``;
+* the closed forms of :class:`safepg.envs.lqg.LQG` (:math:`\theta^*`, :math:`J(\theta^*)`)
+  with the printed values of :mod:`safepg.thesis.lqg_settings` and :data:`PRINTED`;
+* the printed statements of Chapters 3-4 and the appendices against their sympy
+  derivations, as recorded by :func:`safepg.thesis.errata.verified` and
+  :func:`safepg.thesis.errata.errata`.
+
+No number is typed here except the printed values no other module records yet
+(:data:`PRINTED`). Each row gets a status by a stated rule (:data:`RULES`):
+``"reproduced"`` when the rule holds; otherwise ``"differs (explained)"`` when the chapter
+explains the gap (the sentence is kept with the row, :data:`NOTES`), else ``"open"``.
+
+:func:`scorecard` builds the rows (``run=True`` computes missing runs first),
+:func:`write_scorecard` exports them and each thesis table to CSV and JSON, and
+:func:`summary_html` / :func:`group_html` render them for the book's scorecard page.
+
+Modules (their public names used outside the package are available here):
+
+- :mod:`~safepg.thesis.scorecard.rules`: statuses, groups, :data:`PRINTED`, :data:`RULES`,
+  :data:`NOTES`, :class:`Row` and the tolerance functions that apply the rules;
+- :mod:`~safepg.thesis.scorecard.links`: the book's folder :data:`BOOK` and :func:`book_link`;
+- :mod:`~safepg.thesis.scorecard.text`: the cells' texts (percentages, intervals, closed forms);
+- :mod:`~safepg.thesis.scorecard.builder`: the row builder, which applies the rules and the notes;
+- :mod:`~safepg.thesis.scorecard.closed_forms`: the rows of the printed statements and the LQG's
+  closed forms;
+- :mod:`~safepg.thesis.scorecard.runs`: the rows of the Chapter 5 runs;
+- :mod:`~safepg.thesis.scorecard.rows`: :func:`scorecard`, every row;
+- :mod:`~safepg.thesis.scorecard.export`: :func:`counts`, the CSV and JSON files;
+- :mod:`~safepg.thesis.scorecard.page`: the scorecard page's HTML.
+"""
+
+from __future__ import annotations
+
+from safepg.thesis.scorecard.closed_forms import THEORY_LABELS
+from safepg.thesis.scorecard.export import (
+    CSV_COLUMNS,
+    TABLES,
+    counts,
+    read_csv,
+    read_scorecard_json,
+    write_scorecard,
+)
+from safepg.thesis.scorecard.links import BOOK, book_link
+from safepg.thesis.scorecard.page import group_html, summary_html
+from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS, THETA0_VARIANTS, scorecard
+from safepg.thesis.scorecard.rules import (
+    GROUPS,
+    NOTES,
+    PRINTED,
+    RATIO_POINTS,
+    RULES,
+    STATUS_RULE,
+    STATUSES,
+    TABLE_DECIMALS,
+    Note,
+    Row,
+    Status,
+    half_unit,
+    in_seed_range,
+    in_widened_interval,
+    intervals_overlap,
+    order_of_magnitude,
+    within_points,
+    within_rounding,
+)
+
+__all__ = [
+    "BOOK", "CSV_COLUMNS", "GROUPS", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RULES",
+    "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS", "Note", "Row",
+    "Status", "book_link", "counts", "group_html", "half_unit", "in_seed_range", "in_widened_interval",
+    "intervals_overlap", "order_of_magnitude", "read_csv", "read_scorecard_json", "scorecard", "summary_html",
+    "within_points", "within_rounding", "write_scorecard",
+]

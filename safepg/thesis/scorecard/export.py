@@ -1,0 +1,102 @@
+"""The scorecard as files: counts per status, the CSV and JSON of every row and of each thesis table."""
+
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from safepg.thesis.scorecard.rows import scorecard
+from safepg.thesis.scorecard.rules import GROUPS, RULES, STATUS_RULE, STATUSES, Row
+
+
+def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
+    """Number of rows per group and status (groups in :data:`GROUPS` order, plus ``"all"``)."""
+    out: dict[str, dict[str, int]] = {}
+    for r in rows:
+        for g in (r.group, "all"):
+            out.setdefault(g, dict.fromkeys(STATUSES, 0))[r.status] += 1
+    order = [g for g in (*GROUPS, "all") if g in out]
+    return {g: out[g] for g in order}
+
+
+#: Columns of the CSV files (``fields`` go to the table files as their own columns).
+CSV_COLUMNS = ("id", "group", "quantity", "where", "thesis", "ours", "difference", "status", "rule", "explanation",
+               "link", "thesis_value", "ours_value", "ours_ci95_low", "ours_ci95_high", "seeds")
+
+#: The thesis's tables: file stem -> row-id prefix.
+TABLES = {"table-5.1": "table-5.1/", "table-5.2": "table-5.2/", "table-5.3": "table-5.3/", "table-5.4": "table-5.4/"}
+
+
+def _flat(r: Row) -> dict[str, Any]:
+    d = {k: getattr(r, k) for k in CSV_COLUMNS if hasattr(r, k)}
+    lo, hi = (r.ours_ci95 or [None, None])
+    d.update(ours_ci95_low=lo, ours_ci95_high=hi)
+    return d
+
+
+def _write_csv(path: Path, rows: Sequence[dict[str, Any]], columns: Sequence[str]) -> None:
+    with path.open("w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=list(columns), extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: ("" if r.get(k) is None else json.dumps(r[k]) if isinstance(r.get(k), list | dict)
+                            else r[k]) for k in columns})
+
+
+def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **kwargs: Any) -> dict[str, Path]:
+    """Write the scorecard and each thesis table (ours beside the thesis's) as CSV and JSON.
+
+    Parameters
+    ----------
+    path_dir : Path or str
+        Folder to write into (created).
+    rows : sequence of Row, optional
+        Default: :func:`scorecard` called with ``kwargs``.
+
+    Returns
+    -------
+    dict
+        File name -> path: ``scorecard.csv``, ``scorecard.json``, and ``table-5.k.csv`` /
+        ``table-5.k.json`` for k = 1..4.
+    """
+    rows = list(scorecard(**kwargs) if rows is None else rows)
+    out_dir = Path(path_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    meta = {"rules": RULES, "status_rule": STATUS_RULE, "counts": counts(rows)}
+    p = out_dir / "scorecard.json"
+    p.write_text(json.dumps({**meta, "rows": [r.to_dict() for r in rows]}, indent=1, ensure_ascii=False) + "\n",
+                 encoding="utf-8")
+    written[p.name] = p
+    p = out_dir / "scorecard.csv"
+    _write_csv(p, [_flat(r) for r in rows], CSV_COLUMNS)
+    written[p.name] = p
+    for stem, prefix in TABLES.items():
+        sel = [r for r in rows if r.id.startswith(prefix)]
+        keys = list(dict.fromkeys(k for r in sel for k in r.fields))
+        flat = [{**r.fields, **_flat(r)} for r in sel]
+        cols = [*keys, "quantity", "thesis", "ours", "ours_ci95_low", "ours_ci95_high", "difference", "status",
+                "thesis_value", "ours_value", "seeds", "id", "link"]
+        p = out_dir / f"{stem}.csv"
+        _write_csv(p, flat, cols)
+        written[p.name] = p
+        p = out_dir / f"{stem}.json"
+        p.write_text(json.dumps({"table": stem, "rows": [{k: d.get(k) for k in cols} for d in flat]}, indent=1,
+                                ensure_ascii=False) + "\n", encoding="utf-8")
+        written[p.name] = p
+    return written
+
+
+def read_scorecard_json(path: Path | str) -> list[Row]:
+    """The rows of a ``scorecard.json`` written by :func:`write_scorecard`."""
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    return [Row.from_dict(d) for d in data["rows"]]
+
+
+def read_csv(path: Path | str) -> list[dict[str, str]]:
+    """The rows of a CSV written by :func:`write_scorecard` (all values as strings)."""
+    with Path(path).open(newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))

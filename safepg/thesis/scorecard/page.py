@@ -1,0 +1,115 @@
+"""The scorecard page's HTML: the counts per status and one table per group, with the style sheet
+``safepg/thesis/static/scorecard.css``."""
+
+from __future__ import annotations
+
+import html
+import re
+from collections.abc import Sequence
+from functools import cache
+from importlib import resources
+
+from safepg.thesis.scorecard.export import counts
+from safepg.thesis.scorecard.links import heading_id
+from safepg.thesis.scorecard.rules import STATUSES, Row
+
+
+# The tables scroll inside their own box (never the page) with "scroll shadows": a shadow
+# at an edge that has more columns behind it, drawn by background layers that scroll with
+# the content (the covers) over layers that stay put (the shadows). In the dark theme the
+# book draws HTML outputs on a light card; the :has() rule gives ours the page's colours.
+@cache
+def _style_sheet() -> str:
+    """The scorecard tables' style sheet, ``safepg/thesis/static/scorecard.css``, as a
+    ``<style>`` element (read once per process through :mod:`importlib.resources`)."""
+    css = resources.files("safepg.thesis").joinpath("static", "scorecard.css").read_text(encoding="utf-8")
+    return f"\n<style>\n{css}</style>\n"
+
+
+_STATUS_CLASS = {"reproduced": "sc-reproduced", "differs (explained)": "sc-explained", "open": "sc-open"}
+_HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
+         "columns).</p>")
+
+
+def _status_html(status: str) -> str:
+    return f'<span class="sc-status {_STATUS_CLASS[status]}">{html.escape(status)}</span>'
+
+
+def _wrap(table: str, css: bool, label: str) -> str:
+    box = (f'<div class="sc-scroll" tabindex="0" role="region" aria-label="{html.escape(label)} (scrolls sideways)">'
+           f"{table}</div>")
+    return f'{_style_sheet() if css else ""}<div class="sc-out">{_HINT}{box}</div>'
+
+
+def summary_html(rows: Sequence[Row], css: bool = True) -> str:
+    """The counts per group and status, each group linked to its section of the page.
+
+    ``css``: include the style sheet of the scorecard tables (once per page is enough).
+    """
+    c = counts(rows)
+    head = "<tr><th>part of the thesis</th>" + "".join(f"<th>{_status_html(s)}</th>" for s in STATUSES) + \
+        "<th>rows</th></tr>"
+    body = []
+    for g, n in c.items():
+        name = "<strong>all</strong>" if g == "all" else f'<a href="#{heading_id(g)}">{html.escape(g)}</a>'
+        body.append(f"<tr><td>{name}</td>" + "".join(f'<td class="sc-num">{n[s]}</td>' for s in STATUSES)
+                    + f'<td class="sc-num">{sum(n.values())}</td></tr>')
+    table = f'<table class="sc-table sc-summary"><thead>{head}</thead><tbody>{"".join(body)}</tbody></table>'
+    return _wrap(table, css, "rows per status")
+
+
+def _split(text: str) -> str:
+    """A value and its detail (interval, seed range) on two lines."""
+    m = re.fullmatch(r"(.*?) ((?:\[|\().*(?:\]|\)))", text)
+    if m is None:
+        return html.escape(text)
+    return f'{html.escape(m.group(1))}<span class="sc-detail">{html.escape(m.group(2))}</span>'
+
+
+def _cell(text: str, tex: str) -> str:
+    if tex:
+        # A formula cannot wrap: one longer than the cell scrolls inside its own box.
+        return (f'<td class="sc-expr"><div class="sc-math"><span class="math notranslate nohighlight">'
+                f"\\({html.escape(tex)}\\)</span></div></td>")
+    # Numbers stay on one line; a long statement in words wraps.
+    return f'<td class="{"sc-num" if len(text) <= 32 else "sc-words"}">{_split(text)}</td>'
+
+
+def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
+    """The rows of one group as an HTML table that scrolls inside its own box.
+
+    Each row carries ``data-id``, ``data-status``, ``data-thesis`` and ``data-ours`` (the plain
+    texts, also for closed forms shown as typeset math); its explanation, if any, is the
+    line below it.
+    """
+    sel = [r for r in rows if r.group == group]
+    n = counts(sel).get(group, dict.fromkeys(STATUSES, 0))
+    line = ", ".join(f"{n[s]} {s}" for s in STATUSES)
+    cols = ("result", "status", "thesis", "ours", "ours − thesis", "discussed in")
+    head = "<tr>" + "".join(f"<th>{c}</th>" for c in cols) + "</tr>"
+    body = []
+    for r in sel:
+        body.append(
+            f'<tr class="sc-row" data-id="{html.escape(r.id)}" data-status="{html.escape(r.status)}" '
+            f'data-thesis="{html.escape(r.thesis)}" data-ours="{html.escape(r.ours)}">'
+            f'<td class="sc-result">{html.escape(r.quantity)}<span class="sc-detail">{html.escape(r.where)}</span></td>'
+            f"<td>{_status_html(r.status)}</td>{_cell(r.thesis, r.thesis_tex)}{_cell(r.ours, r.ours_tex)}"
+            f'<td class="sc-num">{html.escape(r.difference)}</td>'
+            f'<td><a class="sc-link" href="{html.escape(r.link)}">{html.escape(_link_label(r.link))}</a></td></tr>')
+        if r.explanation:
+            body.append(f'<tr class="sc-note" data-for="{html.escape(r.id)}"><td colspan="{len(cols)}">'
+                        f'<div class="sc-pin">{html.escape(r.explanation)}</div></td></tr>')
+    table = (f'<table class="sc-table sc-rows"><caption><div class="sc-pin">{html.escape(group)}: {line}</div>'
+             f"</caption><thead>{head}</thead>"
+             f"<tbody>{''.join(body)}</tbody></table>")
+    return _wrap(table, css, group)
+
+
+_PAGE_TITLES = {"preliminaries": "Preliminaries", "adaptive_step": "Adaptive step size",
+                "adaptive_batch": "Adaptive batch size", "lqg1d": "One-dimensional LQG", "lqg2d": "Two-dimensional LQG",
+                "cartpole": "Cart-pole", "errata": "Errata"}
+
+
+def _link_label(link: str) -> str:
+    page = link.split(".html")[0]
+    return _PAGE_TITLES.get(page, page)

@@ -1,0 +1,82 @@
+"""The scorecard's rows: the experiments it reads, and :func:`scorecard`, which builds every row."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from safepg.learning import LearningRecord
+from safepg.thesis.experiments import (
+    EXPERIMENTS,
+    Experiment,
+    get_experiment,
+    load_experiment,
+    report,
+    run_experiment,
+)
+from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.closed_forms import closed_form_rows
+from safepg.thesis.scorecard.links import BOOK
+from safepg.thesis.scorecard.rules import GROUPS, Row
+from safepg.thesis.scorecard.runs import run_rows
+
+#: The experiments the scorecard reads (the variant only explains two rows of Table 5.2).
+NEEDED = ("table-5.1", "table-5.2", "figures-5.5-5.6", "table-5.3", "cartpole-baseline", "table-5.4")
+#: The variant of Table 5.2 with the other theoretical range (Lemma 4.3.3's, or the
+#: reconstructed one in older versions), when the library defines it.
+RANGE_VARIANTS = ("table-5.2-lemma-range", "table-5.2-range")
+#: The variant of Table 5.1 from the printed theta_0 (when the table runs from a reconstructed one).
+THETA0_VARIANTS = ("table-5.1-printed-theta0",)
+
+
+def _records(exp: Experiment, root: Path | None, run: bool, jobs: int) -> dict[str, list[LearningRecord]]:
+    if run:
+        return run_experiment(exp, root=root, jobs=jobs, progress=False)
+    return load_experiment(exp, root)
+
+
+def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mapping[str, Experiment] | None = None,
+              jobs: int = -1, book: Path | None = None) -> list[Row]:
+    """Every printed result of the thesis with ours, a status and a link.
+
+    Parameters
+    ----------
+    root : Path, optional
+        Results store (default ``$SAFEPG_RESULTS`` or ``results/``).
+    run : bool
+        Compute the missing runs first (:func:`~safepg.thesis.experiments.run_experiment`); with
+        ``False`` only stored runs are read, and rows without runs are ``"open"``.
+    experiments : mapping, optional
+        Replacements for the experiments of :data:`NEEDED` (and the variants
+        :data:`RANGE_VARIANTS`, :data:`THETA0_VARIANTS`) by
+        name, e.g. :func:`~safepg.thesis.experiments.scaled` copies for a quick look or a test.
+    jobs : int
+        Parallel jobs when ``run`` (joblib's convention).
+    book : Path, optional
+        The book's folder, whose headings give the links' anchors (default ``book/``
+        beside the package).
+
+    Returns
+    -------
+    list of Row
+        Ordered by :data:`GROUPS`, then as in the thesis.
+    """
+    overrides = dict(experiments or {})
+    known = NEEDED + RANGE_VARIANTS + THETA0_VARIANTS
+    unknown = set(overrides) - set(known)
+    if unknown:
+        raise ValueError(f"experiments must be keyed by names in {known}, got {sorted(unknown)}")
+    exps = {n: overrides.get(n) or get_experiment(n) for n in NEEDED}
+    variant = next((n for n in RANGE_VARIANTS if n in overrides or n in EXPERIMENTS), None)
+    t51_variant = next((n for n in THETA0_VARIANTS if n in overrides or n in EXPERIMENTS), None)
+    for n in (variant, t51_variant):
+        if n is not None:
+            exps[n] = overrides.get(n) or get_experiment(n)
+    recs = {n: _records(e, root, run, jobs) for n, e in exps.items()}
+    reps = {n: report(e, recs[n]) for n, e in exps.items()}
+
+    b = Builder(book=book or BOOK)
+    closed_form_rows(b)
+    run_rows(b, exps, reps, recs, variant, t51_variant)
+    order = {g: i for i, g in enumerate(GROUPS)}
+    return sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group

@@ -1,0 +1,281 @@
+"""What the scorecard compares and how it judges: statuses, groups, printed values, rules, notes, rows.
+
+:data:`PRINTED` holds the printed values no other module records; :data:`RULES` states
+each status rule, and the functions below (:func:`within_rounding`, :func:`intervals_overlap`,
+:func:`in_widened_interval`, :func:`within_points`, :func:`in_seed_range`,
+:func:`order_of_magnitude`) apply them; :data:`NOTES` keeps the chapters' explanations of the
+rows that differ; :class:`Row` is one row of the scorecard.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any, Literal
+
+import numpy as np
+
+Status = Literal["reproduced", "differs (explained)", "open"]
+#: The statuses, in the order the page lists them.
+STATUSES: tuple[Status, ...] = ("reproduced", "differs (explained)", "open")
+
+#: Groups of rows, in the order of the thesis (and of the page).
+GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5.2", "Section 5.3")
+
+#: Printed values that no other module records (the others come from the experiments'
+#: ``thesis`` dicts, :mod:`safepg.thesis.lqg_settings` and :mod:`safepg.thesis.errata`). Strings keep the
+#: printed digits, which set the rounding tolerance.
+PRINTED: dict[str, Any] = {
+    # Section 5.1: "theta* ~ -0.59, corresponding to expected performance J(theta*) ~ -13.21".
+    "lqg1d_theta_star": "-0.59",
+    "lqg1d_J_star": "-13.21",
+    # Section 5.1: "step sizes ... of the order of 10^-5" (also "In all the experiments").
+    "lqg1d_step_order": -5,
+    # Section 5.2.1: "The adaptive batch size goes from N ~ 500 in the first learning
+    # iterations, to N ~ 2500 in the end. The step size takes values of the order of 1e-6".
+    "lqg2d_batch_first": "500",
+    "lqg2d_batch_last": "2500",
+    "lqg2d_step_order": -6,
+    # Theorem 4.3.2: "... >= 0.16 ||g||^2", the decimal value of (393 - 95 sqrt 17) / 8.
+    "thm_4_3_2_decimal": "0.16",
+    # Section 5.3: the adaptive method "never updates the components of theta corresponding
+    # to beta and beta-dot" (state [x, x_dot, beta, beta_dot]: components 2 and 3).
+    "cartpole_components_never_updated": (2, 3),
+}
+
+#: Decimals of the printed tables whose values are stored as floats (-20.50 is printed
+#: with two decimals, the float keeps one).
+TABLE_DECIMALS = {"table-5.2": 4, "table-5.3": 2, "table-5.4": 2}
+
+#: Improvement-ratio tolerance, in points of percentage.
+RATIO_POINTS = 5.0
+
+#: The status rules, as stated on the page.
+RULES: dict[str, str] = {
+    "closed-form": "Closed forms (Chapters 3-4, appendices): reproduced when our sympy derivation equals the "
+                   "printed expression (their difference simplifies to 0), is proportional to it by a "
+                   "constant where that is all the text claims, or proves the printed claim, as recorded by "
+                   "safepg.thesis.errata.verified(); a printed statement that differs from its derivation is "
+                   "recorded, with its explanation, by safepg.thesis.errata.errata().",
+    "rounded": "A printed number: reproduced when |ours - thesis| is at most half a unit of its last printed "
+               "digit (-0.59 covers -0.595 to -0.585; a printed 0 must be exactly 0).",
+    "ci-overlap": "Table 5.2 (a mean over 5 runs with its 95% interval): reproduced when our 95% interval over "
+                  "5 seeds overlaps the printed one (two estimates of the same mean).",
+    "ci-contains": "Tables 5.3 and 5.4, average performance (a 5-run mean printed without interval): "
+                   "reproduced when the printed value lies in our 95% interval over seeds, widened by half a "
+                   "unit of its last printed digit.",
+    "ratio-points": f"Improvement ratios: reproduced when |ours - thesis| <= {RATIO_POINTS:g} percentage points "
+                    "(our ratio is the mean over seeds).",
+    "seed-range": "Values from one run (final parameters, iteration counts, batch sizes read off a figure): "
+                  "reproduced when the printed value lies within the range of our seeds, widened by half a "
+                  "unit of its last printed digit.",
+    "order": "\"Of the order of 10^k\": reproduced when the order of magnitude of our median, "
+             "10^floor(log10 x), is 10^k for every configuration.",
+    "set": "A set of components: reproduced when ours is the printed one.",
+}
+
+#: What a row that fails its rule means: ``differs (explained)`` needs the chapter's explanation.
+STATUS_RULE = ("A row that fails its rule is \"differs (explained)\" when the chapter that discusses it explains "
+               "the gap (the one-sentence explanation is in the row, with a link), and \"open\" otherwise.")
+
+
+@dataclass(frozen=True)
+class Note:
+    """Why a row differs (``explains=True``) or what is known about an open row."""
+
+    text: str
+    page: str
+    heading: str
+    explains: bool = True
+
+
+#: Explanations and notes, by row id or id prefix (``"table-5.1/"`` covers every cell).
+#: ``{...}`` fields are filled from the measured values (see :func:`safepg.thesis.scorecard.text.fill`).
+NOTES: dict[str, Note] = {
+    "table-5.1/": Note(
+        "Open: run from θ0 = {t51_theta0}, this cell is more than 5 points from the printed one; the thesis "
+        "states neither the baseline nor the number of runs averaged.", "lqg1d", "Table 5.1", explains=False),
+    "table-5.2/theoretical-range": Note(
+        "The range of the gradient samples behind this row is not printed; rerun, it gives {variant}, "
+        "inside the printed interval.", "lqg1d", "Table 5.2"),
+    "table-5.2/reconstructed-range": Note(
+        "The gradient range behind this row is not printed, and the interval is too narrow for a constant "
+        "that is only reconstructed: {range_gap}.", "lqg1d", "Table 5.2"),
+    "table-5.2/theoretical-range-unexplained": Note(
+        "Open: the range of the gradient samples behind this row is not printed, and neither Lemma 4.3.3's "
+        "range nor our reconstruction reproduces it ({variant}).", "lqg1d", "Table 5.2", explains=False),
+    "section-5.2/theta-star": Note(
+        "Reproduced with γ = 0.9, the discount the Section 5.2 runs use; the printed γ = 0.95 gives "
+        "{theta_printed_setting:.4f}.", "lqg2d", "setting as printed"),
+    "section-5.2/J-star": Note(
+        "Not reproducible at an optimum: the closed form gives {J_used:.3f} at θ* (γ = 0.9) and "
+        "{J_printed_setting:.3f} for the printed γ = 0.95, and no reading of the thesis's or the lab library's "
+        "formula comes near; the chapter reads -422.616 as J near the start, θ = 0 (J(0) = {J0_printed_setting:.3f} "
+        "for the printed γ).", "lqg2d", "lab library"),
+    "section-5.2/theta-final-scalar/11": Note(
+        "A one-digit misprint: the two decoupled diagonal entries differ only by noise, and the printed "
+        "θ22 = -0.013678 matches ours.", "lqg2d", "Figures 5.5 and 5.6"),
+    "section-5.2/batch-": Note(
+        "Open: our adaptive batch size grows from {batch_first:.0f} to {batch_last:.0f} (the thesis reads "
+        "about 500 to 2500 off Figure 5.7); the thesis gives no N_min for this section.", "lqg2d", "Table 5.3",
+        explains=False),
+    "table-5.3/adaptive/upsilon": Note(
+        "The thesis gives no N_min, nor what happens when Assumption 4.2.7 fails, for this section; ours "
+        "(N_min = 100, no update) set the first iterations, which weigh on the average.", "lqg2d", "Table 5.3"),
+    "section-5.3/baseline-iterations": Note(
+        "The count depends strongly on settings the thesis does not state: with the same protocol, 72 lies "
+        "between our counts at γ = 0.99 and γ = 0.995, and the chapter's sweep also reaches it with a 0.01 s "
+        "time step.", "cartpole", "baseline policy"),
+    # The chapter's sweep found the printed result not reproducible under any plausible setting:
+    # an explained difference, not an open one.
+    "table-5.4/": Note(
+        "Not reproducible: the steps Theorem 4.2.3 certifies on this task ({adaptive_steps}) leave θ where the "
+        "baseline left it, so the adaptive method scores the baseline's level on the doubled pole; the chapter's "
+        "sweep over every unstated setting finds none where it learns or where vanilla PG oscillates as "
+        "reported.", "cartpole", "What the sweep says"),
+    "section-5.3/components": Note(
+        "Open: ours also moves {extra} (by at most {extra_move:.0e}); the thesis's constants, which decide "
+        "which component is updated, are not given.", "cartpole", "Table 5.4", explains=False),
+    # Errata rows carry their own sentence (safepg.thesis.errata.errata()); this gives their link.
+    "theory/erratum": Note("", "errata", "Errata"),
+}
+
+
+@dataclass(frozen=True)
+class Row:
+    """One printed result of the thesis, ours beside it.
+
+    Attributes
+    ----------
+    id : str
+        Stable identifier, e.g. ``"table-5.1/sigma=0.5/N=10000/alpha=1e-03"``.
+    group : str
+        One of :data:`GROUPS`.
+    quantity : str
+        What is compared.
+    where : str
+        Thesis section, table or statement.
+    thesis, ours : str
+        As printed / as we compute it (with our 95% interval over seeds where there is one).
+    difference : str
+        ``ours - thesis`` (or the relation of two closed forms).
+    status : {"reproduced", "differs (explained)", "open"}
+    rule : str
+        Key of :data:`RULES` that decided the status.
+    explanation : str
+        One sentence: why it differs, what is known about an open row, or a remark.
+    link : str
+        URL of the book section that discusses it, relative to the book's pages
+        (``"lqg1d.html#table-5-1-fixed-step-size-and-batch-size"``).
+    thesis_value, ours_value : float or None
+        The numbers behind ``thesis`` and ``ours`` when they are numbers.
+    ours_ci95 : list of float or None
+        Our 95% interval over seeds.
+    seeds : int or None
+        Seeds behind ``ours``.
+    thesis_tex, ours_tex : str
+        LaTeX of closed forms ("" for numbers).
+    fields : dict
+        The row's coordinates in its thesis table (sigma, N, alpha, estimator, ...).
+    """
+
+    id: str
+    group: str
+    quantity: str
+    where: str
+    thesis: str
+    ours: str
+    difference: str
+    status: Status
+    rule: str
+    explanation: str
+    link: str
+    thesis_value: float | None = None
+    ours_value: float | None = None
+    ours_ci95: list[float] | None = None
+    seeds: int | None = None
+    thesis_tex: str = ""
+    ours_tex: str = ""
+    fields: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Row:
+        names = {f.name for f in fields(cls)}
+        unknown = set(d) - names
+        if unknown:
+            raise ValueError(f"d has unknown keys {sorted(unknown)}")
+        return cls(**dict(d))
+
+
+# ------------------------------------------------------------------ tolerances
+def half_unit(printed: str) -> float:
+    """Half a unit of the last printed digit of a number as printed.
+
+    ``"-0.59"`` -> 0.005, ``"1.4e-06"`` -> 5e-08, ``"72"`` -> 0.5, ``"2500"`` -> 50 (the
+    trailing zeros of an integer are read as not significant, as in "N ~ 2500").
+
+    Raises
+    ------
+    ValueError
+        If ``printed`` is not a number.
+    """
+    m = re.fullmatch(r"\s*[-+]?(\d*)(?:\.(\d+))?(?:[eE]([-+]?\d+))?\s*", printed)
+    if m is None or not (m.group(1) or m.group(2)):
+        raise ValueError(f"printed must be a number as printed, got {printed!r}")
+    integer, decimals, exponent = m.group(1), m.group(2), int(m.group(3) or 0)
+    if decimals:
+        unit = 10.0 ** -len(decimals)
+    else:
+        stripped = integer.rstrip("0")
+        unit = 10.0 ** (len(integer) - len(stripped)) if stripped else 1.0
+    return 0.5 * unit * 10.0**exponent
+
+
+def within_rounding(ours: float, printed: str) -> bool:
+    """Rule ``"rounded"``: |ours - printed| <= half a unit of its last digit (exact for 0)."""
+    value = float(printed)
+    if value == 0:
+        return ours == 0
+    return abs(ours - value) <= half_unit(printed) * (1 + 1e-9)
+
+
+def intervals_overlap(a: Sequence[float], b: Sequence[float]) -> bool:
+    """Rule ``"ci-overlap"``: two closed intervals [lo, hi] (either order of ends) overlap."""
+    lo_a, hi_a = sorted(a)
+    lo_b, hi_b = sorted(b)
+    return lo_a <= hi_b and lo_b <= hi_a
+
+
+def in_widened_interval(printed: str, ci: Sequence[float]) -> bool:
+    """Rule ``"ci-contains"``: the printed value in our interval widened by half its last digit."""
+    lo, hi = sorted(ci)
+    h = half_unit(printed)
+    return lo - h <= float(printed) <= hi + h
+
+
+def within_points(ours: float, thesis: float, points: float = RATIO_POINTS) -> bool:
+    """Rule ``"ratio-points"``: two ratios in [0, 1] within ``points`` percentage points."""
+    return abs(ours - thesis) * 100 <= points + 1e-9
+
+
+def in_seed_range(values: Sequence[float], printed: str) -> bool:
+    """Rule ``"seed-range"``: the printed value within [min, max] of our seeds, widened."""
+    if len(values) == 0:
+        return False
+    value = float(printed)
+    if value == 0:
+        return bool(np.all(np.asarray(values) == 0))
+    h = half_unit(printed)
+    return min(values) - h <= value <= max(values) + h
+
+
+def order_of_magnitude(x: float) -> int:
+    """floor(log10 |x|): the k of "of the order of 10^k"."""
+    if not x:
+        raise ValueError(f"x must be non-zero, got {x!r}")
+    return math.floor(math.log10(abs(x)))
