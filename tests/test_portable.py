@@ -212,10 +212,28 @@ def test_2d_closed_forms_equal_fixed_order_reference() -> None:
 
 
 # ------------------------------------------------------------------ source scan
-#: Modules whose numbers reach a notebook output, a report or an embedded explorer.
-OUTPUT_MODULES = ["bounds", "constants", "estimators", "learning", "meta", "policies", "trajectories",
-                  "envs/lqg", "envs/cartpole", "experiments", "analysis", "explorers", "lqg_settings",
-                  "figures", "scorecard", "table51_sweep", "cartpole_sweep", "live_learner"]
+#: Modules left out of the scan, and why. Every other module of the package is scanned: its
+#: numbers may reach a notebook output, a report or an embedded explorer.
+NOT_SCANNED = {
+    "portable": "the fixed-order reference implementation itself",
+    "theory/__init__": "symbolic (sympy): exact arithmetic, no floating point",
+    "theory/symbols": "symbolic (sympy)", "theory/step_size": "symbolic (sympy)",
+    "theory/batch_size": "symbolic (sympy)", "theory/appendix_a": "symbolic (sympy)",
+    "theory/appendix_b": "symbolic (sympy)",
+    "envs/gym_task": "a user's gymnasium task: its dynamics are NumPy and libm, documented as not "
+                     "CPU-independent; no thesis output uses it (tests/test_layers.py)",
+    "thesis/lemma_checks": "numeric checks of the inequality lemmas, still on BLAS and NumPy's exp: their "
+                           "verdicts hold with any last bit, but a printed violation at rounding level "
+                           "(Table E.2's 4.82e-16) could change on another CPU; to be made portable",
+}
+
+
+def _modules() -> list[str]:
+    return sorted(str(p.relative_to(ROOT / "safepg"))[:-3] for p in (ROOT / "safepg").rglob("*.py")
+                  if "__pycache__" not in p.parts)
+
+
+OUTPUT_MODULES = [m for m in _modules() if m not in NOT_SCANNED]
 #: (module, enclosing function) pairs allowed to call CPU-dispatched linear algebra, and why.
 ALLOWED = {
     # yes/no answers: only a gain exactly on the stability boundary could flip
@@ -255,10 +273,15 @@ def _calls(module: str) -> list[tuple[str, str, int]]:
     return found
 
 
+def test_scan_covers_every_module() -> None:
+    """The list of modules left out names only modules that exist (no silent loss of coverage)."""
+    assert set(NOT_SCANNED) <= set(_modules()), sorted(set(NOT_SCANNED) - set(_modules()))
+    assert {"learning", "stats", "thesis/experiments", "thesis/scorecard/runs", "thesis/explorers/live_learner"} <= set(
+        OUTPUT_MODULES)
+
+
 @pytest.mark.parametrize("module", OUTPUT_MODULES)
 def test_output_paths_do_not_call_blas(module: str) -> None:
-    if not (ROOT / "safepg" / f"{module}.py").exists():
-        pytest.skip(f"no module {module}")
     bad = [(w, f, line) for w, f, line in _calls(module) if (module, f) not in ALLOWED]
     assert not bad, f"safepg/{module}.py uses CPU-dispatched linear algebra on an output path: {bad}"
 
