@@ -115,13 +115,24 @@ def test_warm_start_is_resolved_before_dispatch(tmp_path, monkeypatch):
     baseline = ex.run_experiment(cheap, jobs=1, root=tmp_path, progress=False)["baseline"][0]
 
     def no_store(*args, **kwargs):
-        raise AssertionError("a run read its starting policy from the store")
+        raise AssertionError("a run read the store")
 
-    monkeypatch.setattr(ex, "warm_start_theta", no_store)
+    # A run computed in this process may read nothing from the store: its start comes with the task.
+    compute = runner._compute
+
+    def compute_without_store(*args):
+        with monkeypatch.context() as m:
+            m.setattr(store, "load_stored", no_store)
+            m.setattr(runner, "load_stored", no_store)
+            return compute(*args)
+
+    monkeypatch.setattr(runner, "_compute", compute_without_store)
     t54 = ex.scaled(ex.get_experiment("table-5.4"), seeds=1, budget=8000)
     recs = ex.run_experiment(t54, jobs=1, root=tmp_path, progress=False)
     for name in ("adaptive", "N=4000"):
         np.testing.assert_array_equal(recs[name][0].theta[0], baseline.theta_final)
+    with pytest.raises(ValueError, match="^theta0 must be given for the warm-started config"):
+        t54.configs[0].run(0)
 
 
 def test_longest_runs_are_dispatched_first(tmp_path, monkeypatch):

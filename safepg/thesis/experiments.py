@@ -22,7 +22,7 @@ import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import CHECKPOINTS, LearningRecord
-from safepg.runner import RunConfig, load_configs, run_configs, store_run, stored_run
+from safepg.runner import RunConfig, load_configs, run_configs, stored_run
 from safepg.runner import make_env as make_core_env
 from safepg.stats import mean_ci95
 from safepg.store import results_dir
@@ -408,17 +408,6 @@ def scaled(exp: Experiment, seeds: int | None = None, budget: int | None = None)
 def experiment_folder(exp: Experiment | str, root: Path | None = None) -> Path:
     """The folder of ``exp``'s runs in the store."""
     return (root or results_dir()) / (exp if isinstance(exp, str) else exp.name)
-
-
-def warm_start_theta(name: str, k: int, root: Path | None = None) -> np.ndarray:
-    """Final theta of seed k of experiment ``name`` (a single-config experiment), run if missing."""
-    exp = get_experiment(name)
-    cfg, folder = _single_config(exp), experiment_folder(exp, root)
-    rec = stored_run(folder, cfg, k)
-    if rec is None:
-        rec = cfg.run(k)
-        store_run(rec, folder, cfg, k)
-    return rec.theta_final
 
 
 def run_experiment(
