@@ -28,11 +28,6 @@ def ci_text(ci: Sequence[float | None] | None, fmt: Callable[[float], str]) -> s
     return f" [{fmt(ci[0])}; {fmt(ci[1])}]"
 
 
-def _decimals_of(printed: str) -> int:
-    m = re.search(r"\.(\d+)", printed)
-    return len(m.group(1)) if m else 0
-
-
 def signed(x: float, decimals: int) -> str:
     """A difference with its sign and ``decimals`` decimals."""
     return f"{x:+.{decimals}f}"
