@@ -9,6 +9,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from decimal import Decimal, InvalidOperation
 from typing import Any
@@ -17,7 +18,7 @@ import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
-from safepg.store import results_dir
+from safepg.store import DamagedRunsError, DamagedRunWarning, results_dir
 from safepg.thesis import experiments
 
 ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
@@ -114,6 +115,10 @@ class NothingStoredError(LookupError):
     """``report`` found no stored run of the experiment (the CLI exits with status 1)."""
 
 
+class DamagedStoreError(LookupError):
+    """``report`` found damaged run files (the CLI names each, says how to repair, exits with status 1)."""
+
+
 def _experiment_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("list", help="name every experiment")
     p.set_defaults(func=_cmd_list)
@@ -152,7 +157,16 @@ def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
 
 def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
     exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
-    out = experiments.report(exp)
+    try:
+        recs = experiments.load_experiment(exp, on_damaged="raise")
+    except DamagedRunsError as err:
+        # A report without them would look complete; ``run`` repairs them (set aside, recomputed).
+        lines = [f"damaged run file {d.path}: {d.reason}" for d in err.damaged]
+        lines.append(f"{len(err.damaged)} damaged run file{'s' * (len(err.damaged) > 1)} of {exp.name}; "
+                     f"repair with: {_run_command(args)} (sets each aside as <file>.damaged-<time> and "
+                     "computes its run again)")
+        raise DamagedStoreError("\nsafepg: ".join(lines)) from None
+    out = experiments.report(exp, recs)
     # The store is keyed by settings, so "nothing stored" often means other --seeds/--budget.
     stored, total = sum(r["seeds"] for r in out["configs"]), len(exp.configs) * exp.seeds
     if stored == 0:
@@ -169,6 +183,17 @@ def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
     return None
 
 
+def _damage_in_one_line(show: Any) -> Any:
+    """``warnings.showwarning`` printing a damaged run file as one line; others go to ``show``."""
+    def show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                     file: Any = None, line: str | None = None) -> None:
+        if issubclass(category, DamagedRunWarning):
+            print(f"safepg: warning: {message}", file=sys.stderr if file is None else file)
+        else:
+            show(message, category, filename, lineno, file, line)
+    return show_warning
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="safepg", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -179,7 +204,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # a usage error (argparse printed it, exit status 2) or --help
         return exc.code if isinstance(exc.code, int) else int(exc.code is not None)
     try:
-        out = _run_learn(args) if args.command == "learn" else args.func(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _damage_in_one_line(warnings.showwarning)
+            out = _run_learn(args) if args.command == "learn" else args.func(args)
         if out is not None:
             json.dump(out, sys.stdout, indent=None if args.command == "learn" else 1)
             sys.stdout.write("\n")
@@ -187,7 +214,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, TypeError) as err:
         print(f"safepg: error: {err}", file=sys.stderr)
         return 2
-    except NothingStoredError as err:
+    except (NothingStoredError, DamagedStoreError) as err:
         print(f"safepg: {err}", file=sys.stderr)
         return 1
     except BrokenPipeError:

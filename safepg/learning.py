@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import warnings
+import zipfile
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -38,6 +39,36 @@ CHECKPOINTS = (100_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
 
 class Task(BoundedTask, Protocol):
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories: ...
+
+
+class RecordFileError(ValueError):
+    """A file that exists but does not hold a readable :class:`LearningRecord`.
+
+    ``path`` is the file and ``reason`` says, in words, what is wrong with it.
+    """
+
+    def __init__(self, path: str | Path, reason: str) -> None:
+        super().__init__(f"{path}: {reason}")
+        self.path, self.reason = Path(path), reason
+
+
+def _damage(err: Exception) -> str:
+    """What is wrong with a run file, in words, from the error that reading it raised."""
+    detail = f"{type(err).__name__}: {err}"
+    if isinstance(err, zipfile.BadZipFile):
+        what = "not a whole .npz archive (truncated or overwritten)"
+    elif isinstance(err, EOFError):
+        what = "empty"
+    elif isinstance(err, ValueError) and "pickle" in str(err):
+        # np.load's message here advises allow_pickle=True, which a damaged file must not get.
+        what, detail = "not an .npz archive (overwritten with other data)", type(err).__name__
+    elif isinstance(err, KeyError | TypeError | AttributeError):
+        what = "not a saved run (an array or the metadata is missing or extra)"
+    elif isinstance(err, json.JSONDecodeError | UnicodeDecodeError):
+        what = "unreadable metadata"
+    else:
+        what = "not a saved run"
+    return f"{what} ({detail})"
 
 
 @dataclass
@@ -161,13 +192,69 @@ class LearningRecord:
                            "reached_target": self.reached_target})
         np.savez_compressed(path, meta=np.array(meta), **arrays)
 
+    def check(self) -> None:
+        """Raise ``ValueError`` unless the arrays have the kinds and lengths of one run.
+
+        With I iterations and m parameters: ``batch_size``, ``alpha``, ``coordinate``,
+        ``J_hat``, ``eps`` and ``safe`` of shape (I,), ``theta`` (I + 1, m), ``J`` (I + 1,)
+        and ``grad`` (I, m); the counts integer, ``safe`` boolean, the rest floating point.
+        The record of every finished run passes; a file that holds anything else is
+        not a run, whatever its archive says.
+        """
+        kinds = {"batch_size": "iu", "alpha": "f", "coordinate": "iu", "theta": "f", "J": "f",
+                 "J_hat": "f", "grad": "f", "eps": "f", "safe": "b"}
+        for name, kind in kinds.items():
+            a = getattr(self, name)
+            if not isinstance(a, np.ndarray) or a.dtype.kind not in kind:
+                raise ValueError(f"{name} must be an array of kind {kind!r}, got {getattr(a, 'dtype', type(a))}")
+        if self.theta.ndim != 2 or self.theta.shape[1] == 0:
+            raise ValueError(f"theta must have shape (iterations + 1, m), got {self.theta.shape}")
+        it, m = self.theta.shape[0] - 1, self.theta.shape[1]
+        shapes = {"batch_size": (it,), "alpha": (it,), "coordinate": (it,), "J": (it + 1,), "J_hat": (it,),
+                  "grad": (it, m), "eps": (it,), "safe": (it,)}
+        for name, shape in shapes.items():
+            if getattr(self, name).shape != shape:
+                raise ValueError(f"{name} must have shape {shape} to match theta {self.theta.shape}, "
+                                 f"got {getattr(self, name).shape}")
+        if not isinstance(self.config, dict):
+            raise ValueError(f"config must be a dict, got {type(self.config).__name__}")
+
     @classmethod
     def load(cls, path: str | Path) -> LearningRecord:
-        with np.load(path) as z:
-            meta = json.loads(str(z["meta"]))
-            arrays = {k: z[k] for k in z.files if k != "meta"}
-        return cls(**arrays, config=meta["config"], interrupted=meta["interrupted"],
-                   diverged=meta.get("diverged", False), reached_target=meta.get("reached_target", False))
+        """Read a record written by :meth:`save`.
+
+        Raises
+        ------
+        RecordFileError
+            The file exists but is not a whole record: empty, truncated, overwritten with
+            something else, missing an array or its metadata, or holding arrays whose
+            lengths do not fit together (:meth:`check`).
+        OSError
+            The file cannot be opened (missing, no permission, a folder): nothing is known
+            about its contents.
+        """
+        try:
+            # Opened here, not by np.load, which leaves its file open when the archive is broken.
+            # allow_pickle=False: a file can only hold plain arrays.
+            with open(path, "rb") as f, np.load(f) as z:
+                meta = json.loads(str(z["meta"]))
+                arrays = {k: z[k] for k in z.files if k != "meta"}
+            rec = cls(**arrays, config=meta["config"], interrupted=bool(meta["interrupted"]),
+                      diverged=bool(meta.get("diverged", False)),
+                      reached_target=bool(meta.get("reached_target", False)))
+        except (FileNotFoundError, PermissionError, IsADirectoryError, MemoryError):
+            raise  # says nothing about the contents
+        except Exception as err:
+            # np.load and zipfile report a damaged file through many types: BadZipFile
+            # (truncated, bad CRC), EOFError (empty), ValueError (pickled or text data),
+            # zlib.error, TypeError (a bare .npy, or an array too many), KeyError and JSON
+            # errors (a missing array or metadata).
+            raise RecordFileError(path, _damage(err)) from err
+        try:
+            rec.check()
+        except ValueError as err:
+            raise RecordFileError(path, f"arrays that do not form one run ({err})") from err
+        return rec
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,9 @@ through joblib (all cores by default; a user with a cluster wraps the call in
 ``joblib.parallel_config(backend="dask")`` or ``"ray"`` without code changes), shows tqdm
 progress, and writes each finished run atomically to ``<folder>/<config>/seed-<k>.npz``
 (:mod:`safepg.store`). An interrupted campaign resumes where it stopped; a run whose
-settings or library version changed is recomputed, the others are not.
+settings or library version changed is recomputed, the others are not. A damaged run file
+(truncated, overwritten) is set aside, named in a warning, and its run computed again
+(:mod:`safepg.store`).
 
 Workers only compute: each returns its :class:`~safepg.learning.LearningRecord` to the
 calling process, which writes it to the store as it arrives. Workers on other machines
@@ -31,7 +33,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
-from safepg.store import load_stored, remove_stale_temp_files, save_atomic
+from safepg.store import DamagedRunsError, OnDamaged, load_stored, remove_stale_temp_files, save_atomic
 
 #: Bump when a change to the library alters the numbers a run produces; stored runs with
 #: another version are recomputed. 2: every output computed in a CPU-independent order
@@ -151,9 +153,12 @@ def run_path(folder: Path, cfg: RunConfig, k: int) -> Path:
     return folder / cfg.name / f"seed-{k}.npz"
 
 
-def stored_run(folder: Path, cfg: RunConfig, k: int) -> LearningRecord | None:
-    """Seed k of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise)."""
-    return load_stored(run_path(folder, cfg, k), cfg.key())
+def stored_run(folder: Path, cfg: RunConfig, k: int, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
+    """Seed k of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
+
+    A damaged file is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
+    """
+    return load_stored(run_path(folder, cfg, k), cfg.key(), on_damaged)
 
 
 def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, k: int) -> None:
@@ -179,12 +184,25 @@ def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
     return i, _compute(cfg, k, theta0, single_thread)
 
 
-def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path) -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``configs`` by config name (missing seeds are left out)."""
+def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
+                 on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``configs`` by config name (missing seeds are left out).
+
+    Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
+    read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
+    """
     out: dict[str, list[LearningRecord]] = {}
+    damaged = []
     for c in configs:
-        recs = [stored_run(folder, c, k) for k in range(seeds)]
+        recs = []
+        for k in range(seeds):
+            try:
+                recs.append(stored_run(folder, c, k, on_damaged))
+            except DamagedRunsError as err:
+                damaged.extend(err.damaged)
         out[c.name] = [r for r in recs if r is not None]
+    if damaged:
+        raise DamagedRunsError(damaged)
     return out
 
 
@@ -214,7 +232,9 @@ def run_configs(
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
 
-    Finished runs are loaded, never recomputed. The runs go to joblib's current backend
+    Finished runs are loaded, never recomputed; a damaged run file is set aside (kept as
+    ``seed-<k>.npz.damaged-<time>``), named in a :class:`~safepg.store.DamagedRunWarning`
+    and its run computed again. The runs go to joblib's current backend
     (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
     worker returns its record and this process saves it as soon as it arrives, so an
     interrupted campaign loses nothing already computed and remote workers need no
@@ -230,7 +250,7 @@ def run_configs(
             raise ValueError(f"starts must give {seeds} starting points for the warm-started config {c.name!r}")
     # Files a killed runner was writing; a live runner's are kept.
     remove_stale_temp_files(folder)
-    todo = [(c, k) for c in configs for k in range(seeds) if stored_run(folder, c, k) is None]
+    todo = [(c, k) for c in configs for k in range(seeds) if stored_run(folder, c, k, "set_aside") is None]
     # Largest budgets first (the budget is the cost we know before running): a long run
     # dispatched last would leave the other workers idle at the end. Stable, so equal
     # budgets keep the given order.

@@ -8,6 +8,13 @@ loss) leaves that temporary file behind, named after its host and process id, so
 :func:`remove_stale_temp_files` can tell it from one a live writer is still writing. Two
 writers may therefore share a folder.
 
+A run file that exists but cannot be read as a record (empty, truncated, overwritten,
+arrays that do not fit together: :class:`~safepg.learning.RecordFileError`) is *damaged*.
+A damaged file is never deleted: the readers leave it out with a warning, and a runner
+about to compute its run again sets it aside first (:func:`set_aside`), keeping it for
+inspection. A readable file of other settings or another ``RESULTS_VERSION`` is not
+damaged but *stale*: it is simply recomputed and overwritten, without a word.
+
 The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
 """
 
@@ -18,9 +25,12 @@ import re
 import socket
 import tempfile
 import time
+import warnings
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Literal
 
-from safepg.learning import LearningRecord
+from safepg.learning import LearningRecord, RecordFileError
 
 #: Suffix of a run file being written. Its name is ``<stem>~<host>~<pid>~<random>.tmp.npz``:
 #: the writer's host and process id tell a later runner whether the writer is still alive.
@@ -29,6 +39,30 @@ TEMP_SUFFIX = ".tmp.npz"
 #: older versions) is stale after this long: writing one run file takes well under a second.
 TEMP_MAX_AGE = 3600.0
 _TEMP_NAME = re.compile(r"^(?P<stem>[^~]+)~(?P<host>[^~]+)~(?P<pid>\d+)~[^~]*" + re.escape(TEMP_SUFFIX) + "$")
+#: A damaged run file set aside: ``seed-3.npz`` becomes ``seed-3.npz.damaged-<UTC time>``, a
+#: name that no reader, runner or clean-up of this module looks at again.
+DAMAGED_SUFFIX = ".damaged-"
+
+#: What a reader does with a damaged run file: ``"warn"`` leaves it out (and where it is)
+#: with a :class:`DamagedRunWarning`, ``"set_aside"`` also moves it aside (for a caller that
+#: computes the run again), ``"raise"`` raises :class:`DamagedRunsError`.
+OnDamaged = Literal["warn", "set_aside", "raise"]
+
+
+class DamagedRunWarning(UserWarning):
+    """A damaged run file was left out of what was read (and perhaps set aside)."""
+
+
+class DamagedRunsError(Exception):
+    """Run files that exist but cannot be read.
+
+    ``damaged`` lists them, one :class:`~safepg.learning.RecordFileError` (``path``,
+    ``reason``) per file.
+    """
+
+    def __init__(self, damaged: Sequence[RecordFileError]) -> None:
+        self.damaged = list(damaged)
+        super().__init__("damaged run files: " + "; ".join(map(str, self.damaged)))
 
 
 def results_dir() -> Path:
@@ -36,21 +70,60 @@ def results_dir() -> Path:
     return Path(os.environ.get("SAFEPG_RESULTS", "results"))
 
 
-def load_stored(path: Path, key: str) -> LearningRecord | None:
+def load_stored(path: Path, key: str, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
     """The finished run stored at ``path`` if it was made by the settings whose key is ``key``.
 
-    Returns ``None`` when the file is missing or unreadable, holds an interrupted run, or
-    was made by other settings (or another library version, which is part of the key).
+    Returns ``None`` when the file is missing, holds an interrupted run, or is stale: made
+    by other settings or another library version (which is part of the key). A damaged
+    file (:class:`~safepg.learning.RecordFileError`) is handled as ``on_damaged`` says
+    (:data:`OnDamaged`); unless that raises, it counts as missing. A file that cannot be
+    opened at all (no permission) raises ``OSError``: that says nothing about its contents.
     """
-    if not path.exists():
-        return None
     try:
+        inode = path.stat().st_ino
         rec = LearningRecord.load(path)
-    except (OSError, ValueError, KeyError):
+    except FileNotFoundError:
+        return None
+    except RecordFileError as err:
+        if on_damaged == "raise":
+            raise DamagedRunsError([err]) from err
+        if on_damaged == "set_aside":
+            moved = set_aside(path, inode)
+            if moved is not None:  # None: another runner has already set it aside
+                warnings.warn(f"damaged run file {path} set aside as {moved.name}, its run is computed again: "
+                              f"{err.reason}", DamagedRunWarning, stacklevel=2)
+        else:
+            warnings.warn(f"damaged run file {path} left out: {err.reason}; computing its run again sets it "
+                          "aside", DamagedRunWarning, stacklevel=2)
         return None
     if rec.interrupted or rec.config.get("run_key") != key:
         return None
     return rec
+
+
+def set_aside(path: Path, inode: int | None = None) -> Path | None:
+    """Rename the damaged run file ``path`` to ``<name>.damaged-<UTC time>`` beside it.
+
+    The file is kept for inspection, never deleted. Returns its new path, or ``None`` when
+    there was nothing to move: ``path`` is gone, or is no longer the file whose inode is
+    ``inode`` (the one found damaged), because another runner sharing the folder set it
+    aside and stored the run again meanwhile. That check is what keeps two runners from
+    setting a good file aside.
+    """
+    try:
+        if inode is not None and path.stat().st_ino != inode:
+            return None
+    except FileNotFoundError:
+        return None
+    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+    dest, n = path.with_name(f"{path.name}{DAMAGED_SUFFIX}{stamp}"), 1
+    while dest.exists():  # damaged again within the same second: keep both
+        dest, n = path.with_name(f"{path.name}{DAMAGED_SUFFIX}{stamp}-{n}"), n + 1
+    try:
+        os.rename(path, dest)
+    except FileNotFoundError:
+        return None
+    return dest
 
 
 def save_atomic(rec: LearningRecord, path: Path) -> None:

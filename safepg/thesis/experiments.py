@@ -25,7 +25,7 @@ from safepg.learning import CHECKPOINTS, LearningRecord
 from safepg.runner import RunConfig, load_configs, run_configs, stored_run
 from safepg.runner import make_env as make_core_env
 from safepg.stats import mean_ci95
-from safepg.store import results_dir
+from safepg.store import OnDamaged, results_dir
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
 #: of the printed 0.95, the discount that reproduces the printed theta*, final parameters and
@@ -421,7 +421,8 @@ def run_experiment(
     """Run every missing (config, seed) of ``exp`` and return all records by config name.
 
     Finished runs are loaded, never recomputed (:func:`safepg.runner.run_configs`, which
-    also says how to run on a Dask cluster). A warm-started experiment first runs the
+    also says how to run on a Dask cluster); a damaged run file is set aside with a
+    warning and its run computed again. A warm-started experiment first runs the
     experiment it starts from, with the same seeds, and hands each seed's final parameters
     to the runner. ``jobs`` follows joblib: a positive count, or -1 for every core (-2 all
     but one, ...).
@@ -445,10 +446,16 @@ def run_experiment(
                        progress=progress, desc=exp.name)
 
 
-def load_experiment(exp: Experiment | str, root: Path | None = None) -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``exp`` by config name (missing seeds are left out)."""
+def load_experiment(exp: Experiment | str, root: Path | None = None,
+                    on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``exp`` by config name (missing seeds are left out).
+
+    Damaged run files are left out with a warning, or with ``on_damaged="raise"`` named
+    all at once in a :class:`~safepg.store.DamagedRunsError`; :func:`run_experiment`
+    sets them aside and computes their runs again.
+    """
     exp = get_experiment(exp) if isinstance(exp, str) else exp
-    return load_configs(exp.configs, exp.seeds, experiment_folder(exp, root))
+    return load_configs(exp.configs, exp.seeds, experiment_folder(exp, root), on_damaged)
 
 
 # ------------------------------------------------------------------ report
