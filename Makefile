@@ -1,13 +1,27 @@
-# Two entry points (see README): `make book` and `make test`. Each installs what it needs.
+# Two entry points (see README): `make book` and `make test`. Each installs what it needs
+# into .venv/, this clone's virtual environment (tools/setup_venv.sh): nothing goes into the
+# interpreter that creates it, which Debian's python3 refuses (PEP 668), and no other clone
+# on the machine sees this clone's safepg. PYTHON is the interpreter that creates .venv.
 PYTHON ?= python3
-PIP := $(PYTHON) -m pip
+VBIN := $(CURDIR)/.venv/bin
+VPY := $(VBIN)/python
+
+# Every recipe runs the venv's tools, and so do their subprocesses (pytest's, jupyter-book's):
+# the venv's bin comes first on the PATH. Jupyter looks for kernels in the venv before
+# anywhere else (JUPYTER_PATH is searched first), so the notebooks' kernel "python3" is the
+# venv's, whatever ~/.local/share/jupyter holds; JUPYTER_PREFER_ENV_PATH also puts the venv
+# before the user's folder for the other Jupyter data.
+export PATH := $(VBIN):$(PATH)
+export VIRTUAL_ENV := $(CURDIR)/.venv
+export JUPYTER_PATH := $(CURDIR)/.venv/share/jupyter
+export JUPYTER_PREFER_ENV_PATH := 1
 
 .PHONY: setup browser-deps lint test test-lib book book-assets bench
 
+# Creates .venv on first use (installing Debian's python3.X-venv as root if missing), reuses
+# it while requirements.txt and pyproject.toml are unchanged.
 setup:
-	$(PIP) install --quiet --disable-pip-version-check -r requirements.txt
-	$(PIP) install --quiet --disable-pip-version-check --no-deps -e .
-	$(PYTHON) -m ipykernel install --user --name python3 >/dev/null
+	@PYTHON_GIVEN=$(if $(filter command line environment override,$(origin PYTHON)),1) bash tools/setup_venv.sh "$(PYTHON)"
 
 # Debian's Chromium for the browser test (Playwright drives it; no browser download).
 browser-deps:
@@ -15,13 +29,13 @@ browser-deps:
 
 # Lint (pyproject.toml's ruff rules) on the library, tests and benchmarks; notebooks are checked by nbval.
 lint: setup
-	$(PYTHON) -m ruff check safepg tests benchmarks
+	$(VPY) -m ruff check safepg tests benchmarks
 
 test: setup browser-deps lint
-	$(PYTHON) -m pytest
+	$(VPY) -m pytest
 
 test-lib: setup
-	$(PYTHON) -m pytest tests -m "not browser"
+	$(VPY) -m pytest tests -m "not browser"
 
 # MathJax from the npm registry into book/_vendor: pages render math offline.
 book-assets:
@@ -30,7 +44,7 @@ book-assets:
 # -W: warnings are errors (broken references, bad math); notebooks run through the cache.
 book: setup book-assets
 	bash book/tools/cache_guard.sh
-	jupyter-book build . -W -n --keep-going
+	$(VBIN)/jupyter-book build . -W -n --keep-going
 
 bench: setup
-	$(PYTHON) benchmarks/bench_iteration.py
+	$(VPY) benchmarks/bench_iteration.py

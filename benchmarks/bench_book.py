@@ -16,6 +16,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -42,7 +43,9 @@ def main() -> None:
         assert not (work / "results").exists() and not (work / "_build").exists()
         t0 = time.perf_counter()
         # From inside the copy: _config.yml's cache path is relative to the working directory.
-        subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=work, check=True,
+        # This interpreter's jupyter-book (.venv's, whose kernel is the venv's), not the PATH's first.
+        subprocess.run([str(Path(sys.executable).with_name("jupyter-book")), "build", ".", "-W", "-n",
+                        "--keep-going"], cwd=work, check=True,
                        stdout=subprocess.DEVNULL)
         wall = time.perf_counter() - t0
         cache = get_cache(str(work / "_build" / ".jupyter_cache"))

@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,9 @@ ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
 SHOTS = ROOT / "_build" / "screenshots"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+#: The jupyter-book of the interpreter running the tests (.venv's under `make test`), not the
+#: first one on the PATH: that one would build the book with another environment's safepg.
+JUPYTER_BOOK = str(Path(sys.executable).with_name("jupyter-book"))
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
 
@@ -51,7 +55,7 @@ def build_book() -> Path:
     """
     subprocess.run(["bash", "book/tools/vendor_assets.sh"], cwd=ROOT, check=True)
     subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
-    subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
+    subprocess.run([JUPYTER_BOOK, "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
                    stdout=subprocess.DEVNULL)
     return HTML
 
