@@ -269,6 +269,8 @@ class _Update:
 
 #: (samples (n, m), their mean, n) -> the update. The loop computes the mean once.
 UpdateRule = Callable[[np.ndarray, np.ndarray, int], _Update]
+#: ``progress`` of the learning loops: True for a tqdm bar, or a callable ``report(used, budget)``.
+Progress = bool | Callable[[int, int], object]
 
 
 def _closed_form(task: Task, thetas: np.ndarray, sigma: float) -> np.ndarray:
@@ -318,7 +320,7 @@ def _learn(
     baseline: bool,
     score_action: ScoreAction,
     config: dict[str, Any],
-    progress: bool,
+    progress: Progress,
     stop_on_divergence: bool = False,
     target_return: float | None = None,
 ) -> LearningRecord:
@@ -328,7 +330,10 @@ def _learn(
     rows: dict[str, list[Any]] = {k: [] for k in ("batch_size", "alpha", "coordinate", "J_hat", "grad", "eps", "safe")}
     used, n = 0, n_first
     interrupted = diverged = reached = False
-    bar = tqdm(total=budget, unit="traj", disable=not progress, leave=False, dynamic_ncols=True)
+    # A callable replaces the bar (a caller that draws its own progress wants no tqdm output).
+    report = progress if callable(progress) else None
+    bar = tqdm(total=budget, unit="traj", disable=report is not None or not progress, leave=False,
+               dynamic_ncols=True)
     try:
         while True:
             # The last batch is cut to the remaining budget, so a run uses exactly `budget`.
@@ -361,6 +366,10 @@ def _learn(
                 rows[k].append(v)
             thetas.append(theta.copy())
             bar.update(n)
+            if report is not None:
+                # Once per batch, after the batch is recorded: whatever it raises (a caller's
+                # cancellation) leaves this loop through the `finally` below and propagates.
+                report(used, budget)
             if reached:
                 break
             n = up.next_n
@@ -417,7 +426,7 @@ def adaptive_pg(
     budget: int = 30_000_000,
     score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
-    progress: bool = False,
+    progress: Progress = False,
 ) -> LearningRecord:
     r"""Adaptive policy gradient, Algorithm 4.1 (as corrected in the book's errata).
 
@@ -443,7 +452,10 @@ def adaptive_pg(
     budget : total number of trajectories
     score_action : "clipped" (the authors' code) or "raw" (unbiased score)
     rng : seed or Generator
-    progress : show a tqdm bar
+    progress : True shows a tqdm bar; a callable ``progress(used, budget)`` is called instead
+        after each batch with the trajectories used so far. An exception it raises stops
+        the run and propagates to the caller, with no record: how a caller running the loop
+        in a thread cancels it (one call per batch, so cancelling waits for one batch).
     """
     check_delta(delta)
     if int(n_min) != n_min or n_min < 2:
@@ -491,7 +503,7 @@ def vanilla_pg(
     budget: int = 1_000_000,
     score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
-    progress: bool = False,
+    progress: Progress = False,
     stop_on_divergence: bool = False,
     target_return: float | None = None,
 ) -> LearningRecord:
@@ -509,6 +521,9 @@ def vanilla_pg(
     it, without updating (``reached_target``): the protocol that learns the cart-pole
     baseline policy of Section 5.3 ("we stop once an average performance of 195 over the
     batch is achieved"). ``budget`` then caps the search.
+
+    ``progress`` is as in :func:`adaptive_pg`: True for a tqdm bar, or a callable
+    ``progress(used, budget)`` called after each batch, whose exceptions stop the run.
     """
     if int(batch_size) != batch_size or batch_size < 2:
         raise ValueError(f"batch_size must be an integer >= 2, got {batch_size}")

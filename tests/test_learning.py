@@ -105,6 +105,28 @@ def test_interrupt_keeps_what_was_computed():
     assert rec.interrupted and rec.iterations == 3 and rec.theta.shape == (4, 1)
 
 
+def test_progress_callable_reports_each_batch_and_can_cancel(capsys):
+    seen = []
+    rec = adaptive_pg(ENV, budget=20_000, rng=3, progress=lambda used, budget: seen.append((used, budget)))
+    # One call per batch, with the trajectories used so far; no tqdm bar beside it.
+    assert [u for u, _ in seen] == np.cumsum(rec.batch_size).tolist() and seen[-1] == (20_000, 20_000)
+    assert capsys.readouterr().err == ""
+    assert _equal(rec, adaptive_pg(ENV, budget=20_000, rng=3))  # reporting changes nothing
+
+    class Cancelled(Exception):
+        pass
+
+    def cancel_at_third(used: int, budget: int) -> None:
+        seen.append(used)
+        if len(seen) == 3:
+            raise Cancelled
+
+    seen = []
+    with pytest.raises(Cancelled):
+        vanilla_pg(ENV, batch_size=100, budget=100_000, rng=0, progress=cancel_at_third)
+    assert seen == [100, 200, 300]  # stopped at once: no fourth batch was drawn
+
+
 @pytest.mark.parametrize(
     "kwargs,name",
     [({"delta": 1.2}, "delta"), ({"delta": 0.0}, "delta"), ({"sigma": 0.0}, "sigma"),
