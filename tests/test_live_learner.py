@@ -98,12 +98,35 @@ def test_interactive_builds_widgets():
     pytest.importorskip("ipywidgets")
     ex = live_batch_size_explorer()
     calls = []
-    # Building the widgets draws once: a stub stands in for the learning run.
-    ex.compute_py = lambda p: calls.append(p) or {"plots": {k: {"series": [{"x": [1, 2], "y": [1, 2]}]}
-                                                            for k in ("N", "J", "alpha")}, "text": ""}
-    w = ex.interactive()
-    assert calls and calls[0]["bound"] == "bernstein-er"
-    names = {c.description for c in w.children[:-1]}
-    assert {"delta", "sigma", "bound", "estimator", "baseline", "score", "seed"} <= names
-    sliders = [c for c in w.children if hasattr(c, "continuous_update") and hasattr(c, "step")]
-    assert sliders and not any(c.continuous_update for c in sliders)  # each move is a learning run: on release
+    # The view computes the defaults at once, in its worker thread: a stub stands in for the learning run.
+    ex.compute_py = lambda p, progress=None: calls.append(p) or {"plots": {k: {"series": [{"x": [1, 2], "y": [1, 2]}]}
+                                                                           for k in ("N", "J", "alpha")}, "text": ""}
+    view = ex.interactive()
+    try:
+        assert view.wait(60)
+        assert calls and calls[0]["bound"] == "bernstein-er" and view.drawn == calls[0]
+        assert {"delta", "sigma", "bound", "estimator", "baseline", "score", "budget", "seed"} <= set(view.controls)
+        sliders = [c for c in view.controls.values() if hasattr(c, "continuous_update") and hasattr(c, "step")]
+        assert sliders and not any(c.continuous_update for c in sliders)  # each move is a learning run: on release
+    finally:
+        view.close()
+
+
+def test_python_twin_reports_progress_and_stops_when_told():
+    ex = live_batch_size_explorer()
+    seen = []
+    res = ex.compute_py({**ex.defaults(), "budget": "10000"}, progress=lambda f, m: seen.append((f, m)))
+    # Two runs of 10^4 trajectories: Algorithm 4.1 fills the first half, vanilla PG the second.
+    assert seen[0][1].startswith("Algorithm 4.1: 100 / 10,000") and seen[-1] == (1.0, "vanilla PG: 10,000 / 10,000 "
+                                                                                     "trajectories")
+    assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
+    assert res["values"] == ex.compute_py({**ex.defaults(), "budget": "10000"})["values"]  # reporting changes nothing
+
+    class Stop(Exception):
+        pass
+
+    def stop(fraction: float, message: str) -> None:
+        raise Stop
+
+    with pytest.raises(Stop):
+        ex.compute_py({**ex.defaults(), "budget": "3000000"}, progress=stop)

@@ -6,7 +6,9 @@ the static book with no kernel and no network, and in JupyterLab. Each explorer 
 JavaScript ``compute`` and a Python twin ``compute_py`` returning the same structure:
 the JavaScript recomputes closed forms (and picks precomputed curves embedded as JSON
 where a closed form is not enough), the Python twin is what the browser test compares
-against, and what :meth:`Explorer.interactive` draws with ipywidgets when a kernel runs.
+against, and what :meth:`Explorer.interactive` draws with ipywidgets when a kernel runs
+(:mod:`~safepg.thesis.explorers.kernel_view`: computed in a worker thread, with progress,
+superseded by the next move).
 
 ``compute(p, data, lib)`` returns ``{"plots": {plot_id: {"series": [...], "markers": [...]}},
 "values": {...}, "text": "..."}``; a series is ``{"label", "x", "y", "color", "dash"}``.
@@ -165,46 +167,24 @@ class Explorer:
     continuous_update: ClassVar[bool] = True
     #: ``interactive()``: width in inches of each plot.
     plot_width: ClassVar[float] = 6.0
+    #: ``interactive()``: whether ``compute_py`` takes ``progress=report``, a callable
+    #: ``report(fraction, message)`` to call while it computes: the view shows how far it is,
+    #: and ``report`` raises once the controls have moved on, which stops the computation.
+    compute_reports_progress: ClassVar[bool] = False
 
     def interactive(self) -> Any:
         """ipywidgets version for a live kernel: the same controls, drawn with matplotlib
-        from ``compute_py``."""
-        import ipywidgets as w
-        import matplotlib.pyplot as plt
+        from ``compute_py`` in a worker thread, with a status line and a progress bar; a
+        move supersedes the running computation, an error is shown as one line.
 
-        kw: dict[str, Any] = {}
-        for c in self.controls:
-            if isinstance(c, Slider):
-                kw[c.name] = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label,
-                                           continuous_update=self.continuous_update)
-            else:
-                kw[c.name] = w.Dropdown(options=[(lbl, v) for v, lbl in c.options], value=c.value,
-                                        description=c.label)
+        Returns
+        -------
+        safepg.thesis.explorers.kernel_view.ExplorerView
+            An ``ipywidgets.VBox``; it has started computing the figure of the defaults.
+        """
+        from safepg.thesis.explorers.kernel_view import ExplorerView
 
-        def draw(**p: Any) -> None:
-            res = self.compute_py(p)
-            fig, axes = plt.subplots(1, len(self.plots), figsize=(self.plot_width * len(self.plots), 3.6),
-                                     squeeze=False)
-            for ax, spec in zip(axes[0], self.plots):
-                r = res["plots"][spec.id]
-                for s in r["series"]:
-                    ax.plot(s["x"], s["y"], color=s.get("color"), linestyle="--" if s.get("dash") else "-",
-                            label=s.get("label"))
-                for mk in r.get("markers", []):
-                    ax.plot([mk["x"]], [mk["y"]], "o", color=mk.get("color"), label=mk.get("label"))
-                ax.set_xscale("log" if spec.xlog else "linear")
-                ax.set_yscale("log" if spec.ylog else "linear")
-                ax.set_xlabel(spec.xlabel)
-                ax.set_ylabel(spec.ylabel)
-                if spec.ymin is not None or spec.ymax is not None:
-                    ax.set_ylim(spec.ymin, spec.ymax)
-                if ax.get_legend_handles_labels()[1]:
-                    ax.legend(fontsize="small")
-            fig.tight_layout()
-            plt.show()
-            print(res.get("text", ""))
-
-        return w.interactive(draw, **kw)
+        return ExplorerView(self)
 
 
 def _json_default(o: Any) -> Any:

@@ -10,7 +10,8 @@ worker and starts a new one; long runs are drawn as they progress.
 
 The Python twin ``compute_py`` runs :func:`safepg.learning.adaptive_pg` and
 :func:`~safepg.learning.vanilla_pg` with the same settings and returns the same structure
-(:meth:`LiveLearnerExplorer.interactive` draws it with ipywidgets). The two use different
+(:meth:`LiveLearnerExplorer.interactive` draws it with ipywidgets, in a worker thread that
+shows each run's progress and stops a run when a control moves). The two use different
 random-number generators (numpy's PCG64 here, xoshiro128** in the page), so for one seed
 their curves differ as two seeds do; tests/test_learner_js.py shows that they agree in
 distribution.
@@ -25,7 +26,7 @@ from __future__ import annotations
 import hashlib
 import html
 import json
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -46,6 +47,8 @@ CURVE_POINTS = 600
 DIGITS = 6
 BOUND_CHOICES = (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"), ("hoeffding-er", "Hoeffding (e.r.)"),
                  ("bernstein", "Bernstein"), ("bernstein-er", "Bernstein (e.r.)"))
+#: ``progress`` of the Python twin: ``report(fraction, message)`` (see ``Explorer.compute_reports_progress``).
+Reporter = Callable[[float, str], object]
 TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in your browser"
 
 
@@ -126,6 +129,7 @@ class LiveLearnerExplorer(Explorer):
     Web Worker (see the module docstring); ``compute_js`` is unused."""
 
     continuous_update = False  # interactive(): each change is a whole learning run, so sliders act on release
+    compute_reports_progress = True  # compute_py(p, progress=report): after each batch of either run
     plot_width = 5.0
 
     def to_html(self) -> str:
@@ -189,8 +193,8 @@ def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | N
             "muted": plotting.MUTED, "vanilla_color": "#444444",
             "colors": {k: v["color"] for k, v in style["bounds"].items()}}
 
-    def compute_py(p: Mapping[str, Any]) -> dict[str, Any]:
-        return _compute_py(p, env, data)
+    def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:
+        return _compute_py(p, env, data, progress)
 
     controls: list[Slider | Select] = [
         Slider("delta", "delta", 0.01, 0.99, 0.01, 0.95),
@@ -220,20 +224,36 @@ def _summary(rec: LearningRecord) -> dict[str, Any]:
             "first_batches": rec.batch_size[:3].tolist(), "done": True, "diverged": rec.diverged}
 
 
-def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any]) -> dict[str, Any]:
+def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
+                progress: Reporter | None = None) -> dict[str, Any]:
     """The Python twin of the page: the same runs with safepg (numpy seeds: adaptive
-    ``seed``, vanilla ``[seed, 1]``), the same plotted structure and values."""
+    ``seed``, vanilla ``[seed, 1]``), the same plotted structure and values.
+
+    ``progress(fraction, message)``, if given, is called after each batch of either run
+    (the two runs are one budget each); what it raises stops the runs and propagates.
+    """
     budget, seed = int(p["budget"]), int(round(float(p["seed"])))
     bound = str(p["bound"])
     common = dict(estimator=p["estimator"], baseline=p["baseline"] == "on", budget=budget,
                   score_action=p["score"])
+    runs = 1 if p["vanilla_n"] == "off" else 2
+
+    def report(k: int, label: str) -> Callable[[int, int], None] | bool:
+        """safepg's per-batch report for run k, as a fraction of all runs (False: no report)."""
+        if progress is None:
+            return False
+        return lambda used, total: progress((k * budget + used) / (runs * budget),
+                                            f"{label}: {used:,} / {total:,} trajectories")
+
     recs = {"adaptive": adaptive_pg(env, 0.0, float(p["sigma"]), bound=bound.replace("-er", ""),
                                     delta=float(p["delta"]), empirical_range=bound.endswith("-er"),
-                                    rng=np.random.default_rng(seed), **common)}
+                                    rng=np.random.default_rng(seed), progress=report(0, "Algorithm 4.1"),
+                                    **common)}
     if p["vanilla_n"] != "off":
         recs["vanilla"] = vanilla_pg(env, 0.0, float(p["sigma"]), batch_size=int(p["vanilla_n"]),
                                      alpha=float(p["vanilla_alpha"]), stop_on_divergence=True,
-                                     rng=np.random.default_rng([seed, 1]), **common)
+                                     rng=np.random.default_rng([seed, 1]), progress=report(1, "vanilla PG"),
+                                     **common)
     plots: dict[str, Any] = {"N": {"series": []}, "J": {"series": []}, "alpha": {"series": []}}
     values: dict[str, Any] = {"done": True}
     key = overlay_key(p)
