@@ -171,6 +171,8 @@ class Explorer:
     #: ``report(fraction, message)`` to call while it computes: the view shows how far it is,
     #: and ``report`` raises once the controls have moved on, which stops the computation.
     compute_reports_progress: ClassVar[bool] = False
+    #: ``interactive()``: the heading, when the page's would be wrong in a kernel (None: ``title``).
+    kernel_title: ClassVar[str | None] = None
 
     def interactive(self) -> Any:
         """ipywidgets version for a live kernel: the same controls, drawn with matplotlib

@@ -64,6 +64,7 @@ def render_png(explorer: Any, res: dict[str, Any], dpi: int = 100) -> bytes:
         The PNG file.
     """
     from matplotlib.figure import Figure  # no pyplot: see the module docstring
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     fig = Figure(figsize=(explorer.plot_width * len(explorer.plots), 3.6))
     axes = fig.subplots(1, len(explorer.plots), squeeze=False)
@@ -76,6 +77,13 @@ def render_png(explorer: Any, res: dict[str, Any], dpi: int = 100) -> bytes:
             ax.plot([mk["x"]], [mk["y"]], "o", color=mk.get("color"), label=mk.get("label"))
         ax.set_xscale("log" if spec.xlog else "linear")
         ax.set_yscale("log" if spec.ylog else "linear")
+        for axis, log in ((ax.xaxis, spec.xlog), (ax.yaxis, spec.ylog)):
+            if log:
+                # Labels at 1, 2, 5 x 10^k: matplotlib's default labels every minor tick on a
+                # range of one or two decades (Upsilon_delta(N)), and the labels overlap.
+                axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+                axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+                axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(spec.xlabel)
         ax.set_ylabel(spec.ylabel)
         if spec.ymin is not None or spec.ymax is not None:
@@ -156,7 +164,9 @@ class ExplorerView(w.VBox):
         self.progress.add_class("safepg-progress")
         self.error = w.HTML()
         self.error.add_class("safepg-error")
-        self.figure = w.Image(format="png", layout=w.Layout(max_width="100%", height="auto"))
+        # Shown at its own size (render_png's 100 dpi), narrowed to the output area if wider.
+        width = round(explorer.plot_width * len(explorer.plots) * 100)
+        self.figure = w.Image(format="png", layout=w.Layout(width=f"{width}px", max_width="100%", height="auto"))
         self.figure.add_class("safepg-figure")
         self.text = w.HTML()
         self.text.add_class("safepg-text")
@@ -168,7 +178,7 @@ class ExplorerView(w.VBox):
         self._pending: tuple[int, dict[str, Any]] | None = None
         self._busy = False
         self._closed = False
-        title = w.HTML(f"<b>{html.escape(explorer.title)}</b>")
+        title = w.HTML(f"<b>{html.escape(explorer.kernel_title or explorer.title)}</b>")
         controls = w.HBox(list(self.controls.values()), layout=w.Layout(flex_flow="row wrap"))
         super().__init__([title, controls, w.HBox([self.progress, self.status]), self.error, self.figure,
                           self.text])

@@ -130,6 +130,7 @@ class LiveLearnerExplorer(Explorer):
 
     continuous_update = False  # interactive(): each change is a whole learning run, so sliders act on release
     compute_reports_progress = True  # compute_py(p, progress=report): after each batch of either run
+    kernel_title = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, rerun by safepg in this kernel"
     plot_width = 5.0
 
     def to_html(self) -> str:
