@@ -1,4 +1,5 @@
-# Two entry points (see README): `make book` and `make test`. Each installs what it needs
+# Two entry points (see README): `make book` and `make test`; `make lab` opens the book's
+# notebooks in JupyterLab. Each installs what it needs
 # into .venv/, this clone's virtual environment (tools/setup_venv.sh): nothing goes into the
 # interpreter that creates it, which Debian's python3 refuses (PEP 668), and no other clone
 # on the machine sees this clone's safepg. PYTHON is the interpreter that creates .venv.
@@ -16,7 +17,7 @@ export VIRTUAL_ENV := $(CURDIR)/.venv
 export JUPYTER_PATH := $(CURDIR)/.venv/share/jupyter
 export JUPYTER_PREFER_ENV_PATH := 1
 
-.PHONY: setup browser-deps lint test test-lib book book-assets bench
+.PHONY: setup browser-deps lint test test-lib book book-assets bench lab
 
 # Creates .venv on first use (installing Debian's python3.X-venv as root if missing), reuses
 # it while requirements.txt and pyproject.toml are unchanged.
@@ -48,3 +49,8 @@ book: setup book-assets
 
 bench: setup
 	$(VPY) benchmarks/bench_iteration.py
+
+# JupyterLab on the book's notebooks (book/) with this clone's kernel, on 127.0.0.1 with a
+# random token (tools/lab.sh); LAB_PORT=8888 by default, LAB_ARGS go to `jupyter lab`.
+lab: setup
+	@bash tools/lab.sh $(LAB_ARGS)
