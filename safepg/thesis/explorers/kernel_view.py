@@ -317,7 +317,7 @@ class ExplorerView(w.VBox):
             self.counts["drawn"] += 1
 
     def __repr__(self) -> str:
-        return f"ExplorerView({self.explorer.title!r})"
+        return f"ExplorerView({self.explorer.kernel_title or self.explorer.title!r})"
 
 
 __all__ = ["ExplorerView", "Superseded", "render_png", "result_text"]

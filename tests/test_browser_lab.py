@@ -1,0 +1,323 @@
+"""The explorers' kernel-backed views in JupyterLab, driven in Chromium as a reader would.
+
+Starts JupyterLab the way `make lab` does (``tools/lab.sh``: this clone's ``.venv`` kernel,
+127.0.0.1, a random token) on a free port, with its runtime, config and data folders in a
+temporary folder, and opens a small notebook that imports the explorers as the chapters
+do and shows each one's ``.interactive()``. After running it, it moves delta and sigma on
+each view (the LQG explorer has sigma only) and checks that the figure's PNG changes, that
+the live learner shows its progress and that a move cancels its run, and that nothing is
+printed to stderr and no view shows an error. The server is then stopped and its
+processes and runtime files are gone. Without the kernel or the widgets' front end
+(``jupyterlab-widgets``) it fails, saying which is missing.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "_build" / "screenshots"
+VENV = ROOT / ".venv"
+pytestmark = pytest.mark.browser
+#: Bounds of each wait (ms): the build machine is shared, a cold kernel imports numba.
+START_S = 120
+KERNEL_MS = 180_000
+DRAW_MS = 120_000
+
+#: The notebook: the chapters' imports, then one view per explorer.
+CELLS = [
+    "import sys\nprint('kernel prefix:', sys.prefix)",
+    "from safepg.thesis.explorers.curves import lqg_explorer, upsilon_explorer\n"
+    "from safepg.thesis.explorers.live_learner import live_batch_size_explorer",
+    "lqg_explorer().interactive()",
+    "upsilon_explorer().interactive()",
+    "live_batch_size_explorer().interactive()",
+]
+VIEWS = ["lqg", "upsilon", "live"]
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def write_notebook(folder: Path) -> Path:
+    import nbformat
+
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = [nbformat.v4.new_code_cell(src) for src in CELLS]
+    path = folder / "explorers.ipynb"
+    nbformat.write(nb, path)
+    return path
+
+
+def write_settings(config: Path) -> None:
+    """JupyterLab settings of the temporary config folder: every cell attached to the page
+    (so every view is in the DOM), and no update or news check (no network here)."""
+    user = config / "lab" / "user-settings" / "@jupyterlab"
+    for ext, name, value in (("notebook-extension", "tracker", {"windowingMode": "none"}),
+                             ("apputils-extension", "notification", {"checkForUpdates": False,
+                                                                     "fetchNews": "false"})):
+        (user / ext).mkdir(parents=True, exist_ok=True)
+        (user / ext / f"{name}.jupyterlab-settings").write_text(json.dumps(value))
+
+
+def processes_mentioning(text: str) -> list[str]:
+    """Command lines of running processes that contain ``text`` (the kernels name their
+    connection file, inside the temporary runtime folder)."""
+    found = []
+    for proc in Path("/proc").glob("[0-9]*"):
+        try:
+            cmd = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if text in cmd:
+            found.append(f"{proc.name}: {cmd}")
+    return found
+
+
+class Lab:
+    """A JupyterLab server started by tools/lab.sh, and what it wrote."""
+
+    def __init__(self, tmp: Path) -> None:
+        self.tmp = tmp
+        self.notebooks = tmp / "notebooks"
+        self.notebooks.mkdir()
+        write_notebook(self.notebooks)
+        self.runtime = tmp / "runtime"
+        write_settings(tmp / "config")
+        env = {**os.environ, "JUPYTER_CONFIG_DIR": str(tmp / "config"), "JUPYTER_RUNTIME_DIR": str(self.runtime),
+               "JUPYTER_DATA_DIR": str(tmp / "data"), "IPYTHONDIR": str(tmp / "ipython"), "TMPDIR": str(tmp),
+               "LAB_PORT": str(free_port())}
+        self.log_path = tmp / "lab.log"
+        self.log = self.log_path.open("w")
+        self.proc = subprocess.Popen(
+            ["bash", str(ROOT / "tools" / "lab.sh"), f"--ServerApp.root_dir={self.notebooks}",
+             "--ServerApp.open_browser=False", "--LabApp.expose_app_in_browser=True"],
+            cwd=ROOT, env=env, stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
+        self.info = self._wait_started()
+
+    def _wait_started(self) -> dict[str, Any]:
+        deadline = time.monotonic() + START_S
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                pytest.fail(f"JupyterLab exited with status {self.proc.returncode}:\n{self.log_text()}")
+            for f in self.runtime.glob("jpserver-*.json"):
+                try:
+                    info = json.loads(f.read_text())
+                except ValueError:  # being written
+                    continue
+                if self._answers(info):
+                    return info
+            time.sleep(0.3)
+        pytest.fail(f"JupyterLab did not start in {START_S} s:\n{self.log_text()}")
+
+    @staticmethod
+    def _answers(info: dict[str, Any]) -> bool:
+        try:
+            urllib.request.urlopen(f"{info['url']}api/status?token={info['token']}", timeout=5).close()
+            return True
+        except (urllib.error.URLError, OSError):
+            return False
+
+    def log_text(self) -> str:
+        self.log.flush()
+        return self.log_path.read_text(errors="replace")[-4000:]
+
+    def stop(self, timeout: float = 30) -> None:
+        """SIGTERM to the server's process group (lab.sh and JupyterLab, which shuts its
+        kernels down), SIGKILL if it has not stopped after ``timeout`` seconds."""
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(10)
+        self.log.close()
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory) -> Iterator[Lab]:
+    if not (VENV / "bin" / "jupyter-lab").exists():
+        pytest.fail(f"{VENV}/bin/jupyter-lab is missing: run `make setup`")
+    tmp = tmp_path_factory.mktemp("lab")
+    server = Lab(tmp)
+    try:
+        yield server
+    finally:
+        server.stop()
+        # Nothing of the server is left: no kernel, no runtime file, no config file with the token.
+        deadline = time.monotonic() + 15
+        while processes_mentioning(str(tmp)) and time.monotonic() < deadline:
+            time.sleep(0.3)
+        left = processes_mentioning(str(tmp))
+        files = [p.name for p in server.runtime.glob("*.json")] + [p.name for p in tmp.glob("safepg-lab-*")]
+        shutil.rmtree(tmp, ignore_errors=True)
+        assert not left, f"processes left running: {left}"
+        assert not files, f"runtime files left: {files}"
+
+
+DIGEST_JS = """async el => {
+  const bytes = await (await fetch(el.src)).arrayBuffer();
+  const d = new Uint8Array(await crypto.subtle.digest('SHA-256', bytes));
+  return Array.from(d, x => x.toString(16).padStart(2, '0')).join('');
+}"""
+
+#: The control values a view's status line says the shown figure is for (None while computing).
+DRAWN_JS = """el => { const s = el.querySelector('.safepg-status [data-params]');
+                      return s ? JSON.parse(s.dataset.params) : null; }"""
+
+
+class View:
+    """One explorer's ipywidgets view in the page."""
+
+    def __init__(self, page: Any, index: int) -> None:
+        self.page = page
+        self.el = page.locator(".safepg-interactive").nth(index)
+
+    def status(self) -> str:
+        return self.el.locator(".safepg-status").inner_text()
+
+    def error(self) -> str:
+        return self.el.locator(".safepg-error").inner_text().strip()
+
+    def drawn(self) -> dict[str, Any] | None:
+        return self.el.evaluate(DRAWN_JS)
+
+    def wait_drawn(self, **want: Any) -> dict[str, Any]:
+        """The drawn values, once the figure of values including ``want`` is shown."""
+        handle = self.el.element_handle()
+        self.page.wait_for_function(
+            f"""([el, want]) => {{ const d = ({DRAWN_JS})(el); const img = el.querySelector('img.safepg-figure');
+                  return d && img && img.src && img.complete && img.naturalWidth > 0
+                         && Object.entries(want).every(([k, v]) => d[k] === v); }}""",
+            arg=[handle, want], timeout=DRAW_MS)
+        return self.drawn()
+
+    def digest(self) -> str:
+        return self.el.locator("img.safepg-figure").evaluate(DIGEST_JS)
+
+    def set_slider(self, name: str, value: float) -> None:
+        """Type ``value`` into the slider's readout and press Enter, as a reader can."""
+        readout = self.el.locator(f".safepg-control-{name} .widget-readout")
+        readout.click()
+        readout.fill(str(value))
+        readout.press("Enter")
+
+    def select(self, name: str, label: str) -> None:
+        """Pick the option shown as ``label`` (ipywidgets' options carry their labels, not their values)."""
+        self.el.locator(f".safepg-control-{name} select").select_option(label=label)
+
+
+def open_and_run(page: Any, lab: Lab) -> None:
+    info = lab.info
+    page.goto(f"{info['url']}lab/tree/explorers.ipynb?token={info['token']}")
+    # The notebook's kernel is idle, or JupyterLab says in a dialog that none could be started.
+    try:
+        page.wait_for_function(
+            """() => { const app = window.jupyterapp; const w = app && app.shell.currentWidget;
+                       const k = w && w.sessionContext && w.sessionContext.session
+                                 && w.sessionContext.session.kernel;
+                       return (k && k.status === 'idle') || document.querySelector('.jp-Dialog'); }""",
+            timeout=KERNEL_MS)
+    except Exception:
+        pass
+    if page.locator(".jp-Dialog").count() or not page.evaluate(
+            "() => window.jupyterapp.shell.currentWidget.sessionContext.session?.kernel?.status === 'idle'"):
+        dialog = page.locator(".jp-Dialog").all_inner_texts()
+        pytest.fail(f"the notebook has no running kernel (JupyterLab's dialog: {dialog}): is the kernel 'python3' "
+                    f"of {VENV} registered? run `make setup`\n{lab.log_text()[-1500:]}")
+    # Not awaited: evaluate has no timeout of its own; the output below has one.
+    page.evaluate("() => { window.jupyterapp.commands.execute('notebook:run-all-cells'); }")
+    page.locator(".jp-OutputArea-output", has_text="kernel prefix:").wait_for(timeout=KERNEL_MS)
+    prefix = page.locator(".jp-OutputArea-output", has_text="kernel prefix:").inner_text().split(":", 1)[1].strip()
+    assert Path(prefix).resolve() == VENV.resolve(), f"the kernel runs {prefix}, not this clone's {VENV}"
+    # Either every view is drawn, or one shows as text: JupyterLab renders a widget's
+    # text/plain only when no front end claims the widget's own type (no jupyterlab-widgets).
+    page.wait_for_function(
+        """n => document.querySelectorAll('.safepg-interactive').length >= n
+               || [...document.querySelectorAll('.jp-OutputArea-output')].some(
+                    e => e.textContent.startsWith('ExplorerView('))""", arg=len(VIEWS), timeout=KERNEL_MS)
+    if page.locator(".safepg-interactive").count() < len(VIEWS):
+        shown = page.locator(".jp-OutputArea-output").all_inner_texts()
+        pytest.fail("the explorers' widgets were not rendered; the outputs show "
+                    f"{[t[:120] for t in shown]}: is jupyterlab-widgets (the ipywidgets front end) installed?")
+
+
+def test_explorers_respond_in_jupyterlab(browser, lab):
+    started = time.monotonic()
+    # http://127.0.0.1 only, and the token is required.
+    assert lab.info["url"].startswith("http://127.0.0.1:") and len(lab.info["token"]) >= 32
+    with pytest.raises(urllib.error.HTTPError) as no_token:
+        urllib.request.urlopen(f"{lab.info['url']}api/kernels", timeout=10)
+    assert no_token.value.code == 403
+
+    page = browser.new_page(viewport={"width": 1400, "height": 2600})
+    page_errors: list[str] = []
+    page.on("pageerror", lambda e: page_errors.append(str(e)))
+    try:
+        open_and_run(page, lab)
+        SHOTS.mkdir(parents=True, exist_ok=True)
+        views = {name: View(page, i) for i, name in enumerate(VIEWS)}
+        report: dict[str, Any] = {}
+
+        # The live learner: a 3·10^6-trajectory run shows its progress, and the next move cancels it.
+        live = views["live"]
+        live.wait_drawn(budget="1000000")
+        live.select("budget", "3,000,000")
+        page.wait_for_function(
+            """el => el.querySelector('.safepg-status').textContent.includes('Algorithm 4.1:')
+                     && getComputedStyle(el.querySelector('.safepg-progress')).visibility === 'visible'""",
+            arg=live.el.element_handle(), timeout=DRAW_MS)
+        progress_line = live.status()
+        live.el.screenshot(path=str(SHOTS / "lab-live-progress.png"))
+        moved = time.monotonic()
+        live.select("budget", "30,000")
+        live.wait_drawn(budget="30000")
+        report["live: 3e6 run cancelled, 3e4 figure after (s)"] = round(time.monotonic() - moved, 2)
+        report["live: progress line"] = progress_line
+        assert "computing…" in progress_line and "trajectories" in progress_line
+
+        for name, view in views.items():
+            view.el.scroll_into_view_if_needed()
+            first = view.wait_drawn()
+            moves = [("sigma", 0.5)] if name == "lqg" else [("delta", 0.5), ("sigma", 1.5)]
+            for control, value in moves:
+                before = view.digest()
+                view.set_slider(control, value)
+                drawn = view.wait_drawn(**{control: value})
+                after = view.digest()
+                assert after != before, f"{name}: moving {control} to {value} did not change the figure"
+                assert view.error() == "", f"{name}: {view.error()}"
+                report[f"{name}: {control} -> {value}"] = {"status": view.status(), "text": view.el.locator(
+                    ".safepg-text").inner_text()[:160]}
+            assert drawn != first
+            view.el.screenshot(path=str(SHOTS / f"lab-{name}.png"))
+
+        stderr = page.locator('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]')
+        assert stderr.count() == 0, stderr.all_inner_texts()
+        errors = page.locator('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.error"]')
+        assert errors.count() == 0, errors.all_inner_texts()
+        assert not [e for e in page_errors if "widget" in e.lower()], page_errors
+        page.screenshot(path=str(SHOTS / "lab-notebook.png"), full_page=True)
+        report["wall time of the test body (s)"] = round(time.monotonic() - started, 1)
+        (SHOTS / "lab_report.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+        print("\n" + json.dumps(report, indent=1, ensure_ascii=False))
+    finally:
+        page.close()
