@@ -34,22 +34,35 @@ def mean_ci95(values: Iterable[float]) -> dict[str, Any]:
 
 @cache
 def t_quantile_975(df: int) -> float:
-    """0.975 quantile of Student's t with ``df`` degrees of freedom.
+    """0.975 quantile of Student's t with ``df`` degrees of freedom (:func:`t_quantile` with both
+    tails holding 0.05, the 95% interval)."""
+    return t_quantile(df, "0.05")
+
+
+@cache
+def t_quantile(df: int, tails: str) -> float:
+    """Upper quantile of Student's t with ``df`` degrees of freedom leaving ``tails`` in the two tails.
+
+    ``tails="0.05"`` gives the 0.975 quantile (a 95% two-sided interval), ``"0.1"`` the 0.95
+    quantile (90%). ``tails`` is a decimal string, read exactly by mpmath.
 
     Computed with mpmath (software arithmetic), not ``scipy.stats.t.ppf``, whose special
     functions call libm and can differ across CPUs in the last bit of a reported interval.
-    Solves :math:`I_x(df/2, 1/2) = 0.05` for :math:`x = df / (df + t^2)`.
+    Solves :math:`I_x(df/2, 1/2) = tails` for :math:`x = df / (df + t^2)`.
     """
     import mpmath
 
     if int(df) != df or df < 1:
         raise ValueError(f"df must be a positive integer, got {df}")
     with mpmath.workdps(40):
+        target = mpmath.mpf(tails)
+        if not 0 < target < 1:
+            raise ValueError(f"tails must be in (0, 1), got {tails!r}")
         a = mpmath.mpf(df) / 2
         lo, hi = mpmath.mpf(0), mpmath.mpf(1)
         for _ in range(80):  # bisection: I_x increases in x; x > 0.006 for df >= 1, so 2^-80 is below its ulp
             mid = (lo + hi) / 2
-            if mpmath.betainc(a, 0.5, 0, mid, regularized=True) < mpmath.mpf("0.05"):
+            if mpmath.betainc(a, 0.5, 0, mid, regularized=True) < target:
                 lo = mid
             else:
                 hi = mid

@@ -6,8 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 stamp=_build/.safepg-hash
-# Every source file of the package, subpackages and their static JavaScript and CSS included.
-now=$(find safepg -type f \( -name '*.py' -o -name '*.js' -o -name '*.css' \) -not -path '*/__pycache__/*' \
+# Every source file of the package, subpackages, their static JavaScript and CSS and the data files included.
+now=$(find safepg -type f \( -name '*.py' -o -name '*.js' -o -name '*.css' -o -path '*/data/*' \) \
+      -not -path '*/__pycache__/*' \
       | LC_ALL=C sort | xargs cat | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$now" ]; then
   rm -rf _build/.jupyter_cache _build/.doctrees _build/jupyter_execute
