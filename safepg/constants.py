@@ -89,13 +89,17 @@ class TaskConstants:
         """Read the constants off an environment for a policy of std ``sigma``.
 
         A task without a ``horizon_term`` attribute gets ``"effective"`` (Theorem 4.2.3 as printed).
+        A task with a ``constants_gamma`` other than None writes the constants in that discount
+        instead of its ``gamma`` (the cart-pole's authors' setting: undiscounted returns, gamma =
+        0.9 in the penalty constant).
         """
+        gamma = getattr(task, "constants_gamma", None)
         return cls(
             R=task.reward_bound,
             M_phi=task.feature_bound,
             A_volume=task.action_volume,
             A_bar=task.action_bound,
-            gamma=task.gamma,
+            gamma=task.gamma if gamma is None else gamma,
             H=task.horizon,
             sigma=float(sigma),
             horizon_term=getattr(task, "horizon_term", "effective"),

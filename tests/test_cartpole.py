@@ -307,3 +307,73 @@ def test_gymnasium_env_uses_the_task_settings() -> None:
     env.reset(options={"state": s0})
     obs, *_ = env.step(np.array([3.0]))
     np.testing.assert_array_equal(obs, step_dynamics(s0, 3.0, tau=0.01, integrator="semi-implicit"))
+
+
+# ------------------------------------------------------------------ the authors' settings
+def test_authors_doubled_pole_one_step_by_hand() -> None:
+    """One step of the authors' doubled pole (half-length 1 m in the angular equation only, m l kept
+    at the 1 m pole's 0.05) against the equations written out by hand, beside the consistent 2 m pole."""
+    x, x_dot, beta, beta_dot, force = 0.1, -0.2, 0.15, 0.8, 6.0
+    s, c = math.sin(beta), math.cos(beta)
+    g, tau, m, total = 9.8, 0.02, 0.1, 1.1
+
+    def by_hand(half: float, ml: float) -> list[float]:
+        temp = (force + ml * beta_dot**2 * s) / total
+        beta_acc = (g * s - c * temp) / (half * (4 / 3 - m * c**2 / total))
+        x_acc = temp - ml * beta_acc * c / total
+        return [x + tau * x_dot, x_dot + tau * x_acc, beta + tau * beta_dot, beta_dot + tau * beta_acc]
+
+    state = np.array([x, x_dot, beta, beta_dot])
+    authors = step_dynamics(state, force, 2.0, polemass_length=0.05)
+    consistent = step_dynamics(state, force, 2.0)
+    np.testing.assert_allclose(authors, by_hand(1.0, 0.05), rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(consistent, by_hand(1.0, 0.1), rtol=1e-14, atol=1e-15)
+    # The stale m l changes both accelerations; positions move with the old velocities either way.
+    assert authors[1] != consistent[1] and authors[3] != consistent[3]
+    assert authors[0] == consistent[0] and authors[2] == consistent[2]
+    # Spelled out at its consistent value, polemass_length changes no bit.
+    rng = np.random.default_rng(5)
+    states, forces = random_states(rng, 200), rng.uniform(-10, 10, 200)
+    for length in (1.0, 2.0):
+        assert np.array_equal(step_dynamics(states, forces, length),
+                              step_dynamics(states, forces, length, polemass_length=0.1 * length / 2))
+
+
+def test_authors_doubled_pole_is_gymnasium_with_length_doubled_after_construction() -> None:
+    """The authors' ``env.length *= 2.0`` on a built env (polemass_length stays cached at 0.05)."""
+    rng = np.random.default_rng(6)
+    states, forces = random_states(rng, 200), rng.uniform(-10, 10, 200)
+    env = CartPoleEnv()
+    env.reset(seed=0)
+    env.length *= 2.0
+    assert env.polemass_length == 0.05
+    theirs = np.array([gym_step(env, s, f)[0] for s, f in zip(states, forces)])
+    task = CartPole.thesis_doubled(polemass_length=0.05)
+    np.testing.assert_allclose(task.step(states, forces), theirs, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(gymnasium_step(states, forces, 2.0, polemass_length=0.05), theirs, rtol=0, atol=0)
+    assert np.abs(theirs - step_dynamics(states, forces, 2.0)).max() > 1e-3
+    # The gymnasium env of a task with the setting steps the same way.
+    single = ContinuousCartPoleEnv(pole_length=2.0, polemass_length=0.05)
+    single.reset(options={"state": states[0]})
+    np.testing.assert_array_equal(single.step(np.array([forces[0]]))[0], task.step(states[0], forces[0]))
+
+
+def test_authors_settings_names_and_constants() -> None:
+    authors = CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9, polemass_length=0.05)
+    name = authors.setting_name()
+    assert name == "cartpole-doubled[gamma=1,angle_threshold_deg=12,polemass_length=0.05,constants_gamma=0.9]"
+    assert CartPole.from_name(name) == authors
+    # Unset, the new fields stay out of the names (and so out of the runs' keys).
+    assert CartPole().setting_name() == "cartpole" and CartPole.thesis_doubled().setting_name() == "cartpole-doubled"
+    assert CartPole(gamma=0.9).setting_name() == "cartpole[gamma=0.9]"
+    # The constants are written in constants_gamma; the simulation keeps gamma = 1 (undiscounted).
+    k = TaskConstants.from_task(authors, 1.0)
+    assert (k.gamma, k.R, k.M_phi, k.A_volume) == (0.9, 1.0, 10.0, 20.0)
+    assert authors.simulate_gain(np.zeros(4), 1.0, 5, 0).gamma == 1.0
+    assert TaskConstants.from_task(CartPole(), 1.0).gamma == 0.99
+    with pytest.raises(ValueError, match="^gamma "):  # gamma = 1 in the printed constant: 1 / (1 - gamma)
+        TaskConstants.from_task(CartPole(gamma=1.0), 1.0)
+    for field, value in (("constants_gamma", 0.0), ("constants_gamma", 1.5), ("polemass_length", -0.05),
+                         ("polemass_length", float("inf"))):
+        with pytest.raises(ValueError, match=rf"^{field} "):
+            CartPole(**{field: value})

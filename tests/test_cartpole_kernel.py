@@ -185,3 +185,49 @@ def test_semi_implicit_kernel_flag() -> None:
         ref, lengths = reference(task, pol, 700, 12, estimator, True, "clipped")
         np.testing.assert_allclose(samples, ref, rtol=1e-9, atol=1e-9)
         np.testing.assert_array_equal(returns, lengths)
+
+
+# ------------------------------------------------------------------ the authors' settings
+AUTHORS = CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9, polemass_length=0.05)
+
+
+@pytest.mark.parametrize("estimator", ["reinforce", "gpomdp"])
+def test_authors_task_fused_matches_reference(estimator: str) -> None:
+    """The stale m l and the undiscounted estimator (gamma = 1) in the kernel, against the numpy path."""
+    pol = LinearGaussianPolicy(np.array([-0.9, 2.1, 3.49, 7.25]), 1.0)  # the authors' baseline policy, rounded
+    samples, returns = AUTHORS.gradient_batch(pol, 1500, 9, estimator)
+    ref, lengths = reference(AUTHORS, pol, 1500, 9, estimator, True, "clipped")
+    np.testing.assert_allclose(samples, ref, rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(returns, lengths)
+    assert 150 < returns.mean() < 200 and returns.min() < AUTHORS.horizon  # some episodes fall at 12 deg
+    consistent = CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0)
+    assert not np.array_equal(consistent.gradient_batch(pol, 1500, 9, estimator)[1], returns)
+
+
+def _reference_peak(task: CartPole, pol: LinearGaussianPolicy, n: int, seed: int) -> float:
+    """max |phi_i(s)| over every state of the simulated batch: the live ones and the one each episode
+    ended in (one more step from its last live state with its last force)."""
+    batch = task.simulate(pol, n, seed)
+    scale = 1.0 if task.feature_scale is None else np.asarray(task.feature_scale)
+    last = batch.mask.sum(axis=1) - 1
+    rows = np.arange(n)
+    final = task.step(batch.features[rows, last] * scale, batch.actions[rows, last, 0]) / scale
+    return float(max(np.abs(batch.features[batch.mask]).max(), np.abs(final).max()))
+
+
+@pytest.mark.parametrize("case", ["theta0", "stable", "doubled"])
+def test_batch_maxima_are_the_largest_reward_and_feature(case: str) -> None:
+    task, K, sig = CASES[case]
+    pol = LinearGaussianPolicy(K, sig)
+    samples, returns, (R, M_phi) = task.gradient_batch_maxima(pol, N, 5)
+    plain = task.gradient_batch(pol, N, 5)
+    assert np.array_equal(samples, plain[0]) and np.array_equal(returns, plain[1])  # the same batch
+    assert R == 1.0
+    assert M_phi == pytest.approx(_reference_peak(task, pol, N, 5), rel=1e-12)
+    # Normalised features: the largest normalised component.
+    from safepg.envs.cartpole import NORMALISED_SCALE
+
+    scaled = CartPole(feature_scale=NORMALISED_SCALE, feature_bound=1.0)
+    pol_scaled = LinearGaussianPolicy(K * np.asarray(NORMALISED_SCALE), sig)  # the same policy in those units
+    assert scaled.gradient_batch_maxima(pol_scaled, 300, 5)[2][1] == pytest.approx(
+        _reference_peak(scaled, pol_scaled, 300, 5), rel=1e-12)

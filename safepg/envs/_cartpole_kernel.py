@@ -38,49 +38,51 @@ CHUNK = 512
 
 
 @njit(cache=True)
-def _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau):
+def _euler(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau):
     """One explicit-Euler step; the same operations in the same order as ``step_dynamics``."""
     sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
     cos = portable.cos(beta)
-    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    push = (force + ml * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
-    x_acc = push - pole_mass * half * beta_acc * cos / total
+    x_acc = push - ml * beta_acc * cos / total
     return x + tau * x_dot, x_dot + tau * x_acc, beta + tau * beta_dot, beta_dot + tau * beta_acc
 
 
 @njit(cache=True)
-def _semi_implicit(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau):
+def _semi_implicit(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau):
     """One semi-implicit Euler step (velocities first, positions with the new velocities), the
     same operations as ``step_dynamics(..., integrator="semi-implicit")``."""
     sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
     cos = portable.cos(beta)
-    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    push = (force + ml * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
-    x_acc = push - pole_mass * half * beta_acc * cos / total
+    x_acc = push - ml * beta_acc * cos / total
     x_dot_new = x_dot + tau * x_acc
     beta_dot_new = beta_dot + tau * beta_acc
     return x + tau * x_dot_new, x_dot_new, beta + tau * beta_dot_new, beta_dot_new
 
 
 @njit(cache=True)
-def _step(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau, semi_implicit):
+def _step(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau, semi_implicit):
     """The integrator the task asked for (a branch, so the Euler path keeps its exact operations)."""
     if semi_implicit:
-        return _semi_implicit(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau)
-    return _euler(x, x_dot, beta, beta_dot, force, half, total, pole_mass, gravity, tau)
+        return _semi_implicit(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau)
+    return _euler(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau)
 
 
 @njit(cache=True)
 def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, x_threshold, angle_threshold,
                 score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept,
-                semi_implicit):
+                semi_implicit, peak):
     """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
-    lengths, and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
+    lengths, their largest |state component| (``peak``, the initial and the final state
+    included), and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
     H = zz.shape[1]
-    half, total, pole_mass, gravity, tau = consts
+    half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
     for n in range(lo, hi):
         x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
+        p0, p1, p2, p3 = abs(x), abs(x_dot), abs(beta), abs(beta_dot)
         g0 = g1 = g2 = g3 = 0.0  # cumulative scores
         a0 = a1 = a2 = a3 = 0.0  # G(PO)MDP sample without baseline
         disc = 1.0
@@ -111,13 +113,15 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
                     den[t, 2] += g2 * g2
                     den[t, 3] += g3 * g3
             disc *= gamma
-            x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, total, pole_mass, gravity, tau,
+            x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass, gravity, tau,
                                              semi_implicit)
+            p0, p1, p2, p3 = max(p0, abs(x)), max(p1, abs(x_dot)), max(p2, abs(beta)), max(p3, abs(beta_dot))
             # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
             if not (abs(x) <= x_threshold and abs(beta) <= angle_threshold):
                 T = t + 1
                 break
         lengths[n] = T
+        peak[n, 0], peak[n, 1], peak[n, 2], peak[n, 3] = p0, p1, p2, p3
         if reinforce_estimator:
             samples[n, 0] = g0 * ret
             samples[n, 1] = g1 * ret
@@ -146,7 +150,7 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
 def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_clipped, b, suffix,
                  samples, lengths, semi_implicit):
     """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again."""
-    half, total, pole_mass, gravity, tau = consts
+    half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
     for n in range(lo, hi):
         x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
@@ -168,7 +172,7 @@ def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_
             a2 += g2 * b[t, 2]
             a3 += g3 * b[t, 3]
             if t + 1 < T:  # the state after the last step is never used
-                x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, total, pole_mass,
+                x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass,
                                                  gravity, tau, semi_implicit)
         samples[n, 0] -= a0 + g0 * suffix[T, 0]
         samples[n, 1] -= a1 + g1 * suffix[T, 1]
@@ -220,7 +224,8 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                               pole_mass: float, gravity: float, tau: float, s0: np.ndarray, z: np.ndarray,
                               gamma: float, action_bound: float, x_threshold: float, angle_threshold: float,
                               score_clipped: bool, reinforce_estimator: bool,
-                              baseline: bool, semi_implicit: bool = False) -> tuple[np.ndarray, np.ndarray]:
+                              baseline: bool, semi_implicit: bool = False, polemass_length: float | None = None,
+                              peaks: bool = False) -> tuple[np.ndarray, ...]:
     """Per-trajectory REINFORCE or G(PO)MDP samples (N, 4) and episode lengths (N,).
 
     Parameters
@@ -244,6 +249,11 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         of G(PO)MDP; subtract the variance-minimising baseline.
     semi_implicit : bool
         Integrate with the semi-implicit Euler scheme instead of the explicit one (default).
+    polemass_length : float or None
+        m l of the pole's momentum terms; None: ``pole_mass * pole_length / 2`` (see
+        :func:`safepg.envs.cartpole.step_dynamics`).
+    peaks : bool
+        Also return each trajectory's largest |state component|.
 
     Returns
     -------
@@ -251,6 +261,9 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         Gradient samples, as ``gradient_samples`` on the simulated batch.
     lengths : ndarray, shape (N,)
         Episode lengths (float), i.e. the undiscounted returns (reward 1 per live step).
+    peak : ndarray, shape (N, 4)
+        Only with ``peaks=True``: max |s_i| over the states of each trajectory, from the initial
+        state to the last one reached (the failing state, or s_H), component by component.
     """
     # One compiled specialisation only: numba compiles again (about 10 s) for every new
     # combination of argument types, e.g. a 3-D z, an int constant or a numpy bool flag.
@@ -262,20 +275,25 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
     if not (z.ndim == 2 or (z.ndim == 3 and z.shape[2] == 1)) or z.shape[0] != s0.shape[0]:
         raise ValueError(f"z must have shape (N, H) or (N, H, 1) with N = {s0.shape[0]}, got {z.shape}")
     zz = np.ascontiguousarray(z.reshape(z.shape[0], z.shape[1]))
-    return _fused(K, float(sigma), float(pole_length), float(cart_mass), float(pole_mass), float(gravity),
-                  float(tau), s0, zz, float(gamma), float(action_bound), float(x_threshold),
-                  float(angle_threshold), bool(score_clipped), bool(reinforce_estimator), bool(baseline),
-                  bool(semi_implicit))
+    half = 0.5 * float(pole_length)
+    # pole_mass * half is the product the consistent equations form first: the same bits.
+    ml = float(pole_mass) * half if polemass_length is None else float(polemass_length)
+    samples, lengths, peak = _fused(K, float(sigma), half, ml, float(cart_mass), float(pole_mass), float(gravity),
+                                    float(tau), s0, zz, float(gamma), float(action_bound), float(x_threshold),
+                                    float(angle_threshold), bool(score_clipped), bool(reinforce_estimator),
+                                    bool(baseline), bool(semi_implicit))
+    return (samples, lengths, peak) if peaks else (samples, lengths)
 
 
 @njit(cache=True, parallel=True)
-def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, gamma, action_bound, x_threshold,
+def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, s0, zz, gamma, action_bound, x_threshold,
            angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
     """:func:`cartpole_gradient_samples` on normalised arguments (zz is (N, H))."""
     N, H = zz.shape[0], zz.shape[1]
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.zeros((N, 4))
     lengths = np.empty(N)
+    peak = np.empty((N, 4))
     gpomdp_baseline = baseline and not reinforce_estimator
     rows = 1 if reinforce_estimator else H
     num = np.zeros((n_chunks if baseline else 1, rows, 4))
@@ -285,7 +303,7 @@ def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, ga
     # REINFORCE's baseline needs only the total score S_n, not a second simulation.
     kept = np.empty((N if baseline and reinforce_estimator else 1, 4))
     inv_var = 1.0 / (sigma * sigma)
-    consts = (0.5 * pole_length, cart_mass + pole_mass, pole_mass, gravity, tau)
+    consts = (half, ml, cart_mass + pole_mass, pole_mass, gravity, tau)
     # Without a baseline the sums are never touched: every chunk gets the same dummy row.
     i_step = 1 if baseline else 0
     j_step = 1 if gpomdp_baseline else 0
@@ -294,18 +312,18 @@ def _fused(K, sigma, pole_length, cart_mass, pole_mass, gravity, tau, s0, zz, ga
         j = c * j_step
         _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, gamma,
                     action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
-                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit)
+                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit, peak)
     if not baseline:
-        return samples, lengths
+        return samples, lengths, peak
 
     b, suffix = _baseline(num, den, ended, gpomdp_baseline)
     if reinforce_estimator:
         for n in range(N):
             for p in range(4):
                 samples[n, p] -= kept[n, p] * b[0, p]
-        return samples, lengths
+        return samples, lengths, peak
 
     for c in prange(n_chunks):
         _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, action_bound,
                      score_clipped, b, suffix, samples, lengths, semi_implicit)
-    return samples, lengths
+    return samples, lengths, peak

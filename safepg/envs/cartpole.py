@@ -42,6 +42,11 @@ in old gym's CartPole-v0 documentation, which mislabels the observation *box* ha
 0.418 rad (= 2 x 12 degrees = 24 degrees), as degrees. The thesis prints 41.8 degrees, so
 that is the default; ``angle_threshold_deg=12`` gives gym's task.
 
+The authors' code ran gym's 12 degrees, doubled the pole by changing gym's half-length after
+the env had cached the pole's m l (``polemass_length``), and estimated the gradient of the
+undiscounted return with gamma = 0.9 in the penalty constant: ``angle_threshold_deg=12``,
+``polemass_length=0.05``, ``gamma=1``, ``constants_gamma=0.9`` (the fields below).
+
 Rewards and the mask: at step t the episode is alive if s_t is inside the thresholds;
 then the agent acts, gets r_t = 1 and the system moves to s_{t+1}. If s_{t+1} is outside,
 steps t+1, ..., H-1 are dead (mask False, reward 0, features and actions 0). So, as in
@@ -86,6 +91,7 @@ def step_dynamics(
     gravity: float = _GRAVITY,
     tau: float = _TAU,
     integrator: str = "euler",
+    polemass_length: float | None = None,
 ) -> np.ndarray:
     r"""One explicit-Euler (or semi-implicit Euler) step of the cart-pole, vectorised over leading axes.
 
@@ -103,6 +109,12 @@ def step_dynamics(
         ``"euler"``: positions advance with the *old* velocities (gymnasium's default
         ``kinematics_integrator="euler"``). ``"semi-implicit"``: velocities first, then
         positions with the *new* velocities (gymnasium's ``"semi-implicit euler"``).
+    polemass_length : float or None
+        m l, the pole mass times the half-length, in the two terms of the pole's momentum
+        (the centrifugal pull and the reaction on the cart). None: ``pole_mass * pole_length / 2``,
+        a consistent pole. gymnasium caches it as ``polemass_length`` when the env is built, so
+        changing its ``length`` afterwards changes l only in the angular acceleration's
+        denominator (see :class:`CartPole`).
 
     Returns
     -------
@@ -113,13 +125,15 @@ def step_dynamics(
     s = np.asarray(state, dtype=float)
     x, x_dot, beta, beta_dot = s[..., 0], s[..., 1], s[..., 2], s[..., 3]
     half = 0.5 * pole_length  # the equations use the distance hinge -> centre of mass
+    # The same product the consistent pole's equations form first (same bits either way).
+    ml = pole_mass * half if polemass_length is None else polemass_length
     total = cart_mass + pole_mass
     # The kernel's sine and cosine (safepg.portable): the same bits on every CPU, unlike libm's.
     sin, cos = portable.sin_array(beta), portable.cos_array(beta)
     # Force on the cart plus the centrifugal pull of the pole, per unit of total mass.
-    push = (force + pole_mass * half * beta_dot * beta_dot * sin) / total
+    push = (force + ml * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
-    x_acc = push - pole_mass * half * beta_acc * cos / total
+    x_acc = push - ml * beta_acc * cos / total
     out = np.empty(np.broadcast_shapes(s.shape, np.shape(force) + (4,)))
     out[..., 1] = x_dot + tau * x_acc
     out[..., 3] = beta_dot + tau * beta_acc
@@ -235,6 +249,19 @@ class CartPole:
         ``"effective"`` (default) h = 1 / (1 - gamma), as printed; ``"truncated"``
         h = (1 - gamma^H) / (1 - gamma), the discounted sums cut at H; ``"horizon"``
         h = H = 200. Only the bound constants change, not the simulation.
+    polemass_length : float or None
+        m l, the pole mass times the half-length, in the pole's momentum terms of both
+        equations (see :func:`step_dynamics`). None (default): ``pole_mass * pole_length / 2``,
+        a consistent pole. The authors doubled the pole with ``env.length *= 2`` after gym had
+        cached ``polemass_length = 0.1 * 0.5 = 0.05`` in ``__init__``, so their doubled pole is
+        ``pole_length=2, polemass_length=0.05``: the new half-length (1 m) enters only the
+        denominator of the angular acceleration, the m l terms stay those of the 1 m pole.
+    constants_gamma : float or None
+        The discount the bound constants (penalty constant, Chebyshev variances, Lemma 4.3.3's
+        range) are written in; None (default): ``gamma``. Only the constants change, not the
+        simulation nor the estimators. The authors' cart-pole scripts estimate the gradient of
+        the undiscounted return (``gamma=1``, a ``sigma**l`` typed for ``gamma**l``) and put
+        gamma = 0.9 into the penalty constant.
     """
 
     pole_length: float = _POLE_LENGTH
@@ -255,6 +282,8 @@ class CartPole:
     reward_bound: float = 1.0
     action_space_volume: float | None = None
     horizon_term: str = "effective"
+    polemass_length: float | None = None
+    constants_gamma: float | None = None
 
     #: State and action dimensions (the features are the state, or its normalisation: d_phi = 4).
     state_dim: ClassVar[int] = 4
@@ -273,9 +302,12 @@ class CartPole:
         _check_integrator(self.integrator)
         if self.horizon_term not in HORIZON_TERMS:
             raise ValueError(f"horizon_term must be one of {HORIZON_TERMS}, got {self.horizon_term!r}")
-        v = self.action_space_volume
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ValueError(f"action_space_volume must be finite and > 0 or None, got {v}")
+        for name in ("action_space_volume", "polemass_length"):
+            v = getattr(self, name)
+            if v is not None and not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0 or None, got {v}")
+        if self.constants_gamma is not None and not 0 < self.constants_gamma <= 1:
+            raise ValueError(f"constants_gamma must be in (0, 1] or None, got {self.constants_gamma}")
         if self.feature_scale is not None:
             sc = self.feature_scale
             if (not isinstance(sc, tuple) or len(sc) != self.state_dim
@@ -351,7 +383,8 @@ class CartPole:
     def step(self, state: np.ndarray, force: np.ndarray | float) -> np.ndarray:
         """:func:`step_dynamics` with this task's physical constants (force not clipped)."""
         return step_dynamics(state, force, self.pole_length, cart_mass=self.cart_mass, pole_mass=self.pole_mass,
-                             gravity=self.gravity, tau=self.tau, integrator=self.integrator)
+                             gravity=self.gravity, tau=self.tau, integrator=self.integrator,
+                             polemass_length=self.polemass_length)
 
     def features(self, state: np.ndarray) -> np.ndarray:
         """phi(s): the state itself, or ``state / feature_scale`` with normalised features."""
@@ -481,6 +514,42 @@ class CartPole:
             the thesis reports for the cart-pole (:meth:`measured_returns`). Note that
             :meth:`safepg.envs.LQG.gradient_batch` returns *discounted* returns instead.
         """
+        samples, returns, _ = self._fused_batch(policy, n, rng, estimator, baseline, score_action, peaks=False)
+        return samples, returns
+
+    def gradient_batch_maxima(
+        self,
+        policy: LinearGaussianPolicy,
+        n: int,
+        rng: RNGLike = None,
+        estimator: str = "gpomdp",
+        baseline: bool = True,
+        score_action: str = "clipped",
+    ) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """:meth:`gradient_batch` and the reward and feature bounds measured on the batch.
+
+        The same batch (the same random numbers) as :meth:`gradient_batch`, plus what the
+        authors' cart-pole script put into the penalty constant in place of R and M_phi: the
+        largest |reward| and the largest |phi_i(s)| over every state the batch visited, the
+        initial states and the states the episodes ended in (the failing state, or s_H)
+        included. The learning loop's ``constants="batch"`` calls it.
+
+        Returns
+        -------
+        samples, returns : ndarray
+            As :meth:`gradient_batch`.
+        maxima : (float, float)
+            (R, M_phi) of the batch. R is 1: every episode is rewarded on its first step.
+        """
+        samples, returns, peak = self._fused_batch(policy, n, rng, estimator, baseline, score_action, peaks=True)
+        if self.feature_scale is not None:
+            peak = peak / np.asarray(self.feature_scale)
+        return samples, returns, (1.0, float(peak.max()))
+
+    def _fused_batch(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike, estimator: str, baseline: bool,
+                     score_action: str, peaks: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """The fused kernel on a fresh batch: samples, undiscounted returns and (with ``peaks``) each
+        trajectory's largest |state component| (else None)."""
         from safepg.envs._cartpole_kernel import cartpole_gradient_samples
 
         n = self._check_policy_and_n(policy, n)
@@ -497,14 +566,15 @@ class CartPole:
             scale = np.asarray(self.feature_scale)
             gain = gain / scale
         # The wrapper normalises the argument types (one compiled specialisation).
-        samples, returns = cartpole_gradient_samples(
+        out = cartpole_gradient_samples(
             gain, policy.cov_chol[0, 0], self.pole_length, self.cart_mass, self.pole_mass, self.gravity,
             self.tau, s0, z, self.gamma, self.action_bound, self.x_threshold, self.angle_threshold,
             score_action == "clipped", estimator == "reinforce", baseline,
-            semi_implicit=self.integrator == "semi-implicit")
+            semi_implicit=self.integrator == "semi-implicit", polemass_length=self.polemass_length, peaks=peaks)
+        samples, returns = out[0], out[1]
         if self.feature_scale is not None:
             samples /= scale
-        return samples, returns
+        return samples, returns, out[2] if peaks else None
 
     def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
                       rng: RNGLike = None) -> Trajectories:
@@ -633,7 +703,7 @@ if _gym is not None:
             return self.state.copy(), 1.0, self._terminated, self._truncated, {}
 
     def gymnasium_step(states: np.ndarray, forces: np.ndarray, pole_length: float = _POLE_LENGTH,
-                       integrator: str = "euler") -> np.ndarray:
+                       integrator: str = "euler", polemass_length: float | None = None) -> np.ndarray:
         """One step of gymnasium's own ``CartPoleEnv`` from each state with each force.
 
         The independent implementation :func:`step_dynamics` is checked against (tests
@@ -650,6 +720,10 @@ if _gym is not None:
             Whole pole length in m.
         integrator : {"euler", "semi-implicit"}
             gymnasium's ``kinematics_integrator`` ``"euler"`` or ``"semi-implicit euler"``.
+        polemass_length : float or None
+            The env's cached ``polemass_length``; None: ``masspole * length``, consistent with
+            ``pole_length``. 0.05 with ``pole_length=2`` is the authors' doubled pole
+            (``env.length *= 2`` after construction).
         """
         from gymnasium.envs.classic_control.cartpole import CartPoleEnv
 
@@ -662,7 +736,8 @@ if _gym is not None:
         env = CartPoleEnv()
         env.reset(seed=0)
         env.length = 0.5 * pole_length
-        env.polemass_length = env.masspole * env.length  # cached in __init__: keep it consistent
+        # Cached in __init__: keep it consistent, unless asked for the authors' stale value.
+        env.polemass_length = env.masspole * env.length if polemass_length is None else polemass_length
         env.kinematics_integrator = "euler" if integrator == "euler" else "semi-implicit euler"
         out = np.empty_like(S)
         with warnings.catch_warnings():  # stepping "after termination" is what we want here
