@@ -108,6 +108,8 @@ def error_bound(
     estimator: str = "gpomdp",
     empirical_range: bool = False,
     theoretical_range: float | None = None,
+    variance: float | None = None,
+    sample_range: float | None = None,
 ) -> ErrorBound:
     """The bound of Section 4.3 for one gradient component.
 
@@ -126,6 +128,10 @@ def error_bound(
         instead of Lemma 4.3.3's range.
     theoretical_range : float, optional
         Replace Lemma 4.3.3's range (used when ``empirical_range`` is False) by this value.
+    variance, sample_range : float, optional
+        Use these in place of the sample variance (ddof = 1) and the range max - min of
+        ``samples`` (Bernstein; empirical range), e.g. the largest over all components, as
+        the authors' 2-D and cart-pole scripts did.
     """
     check_delta(delta)
     samples = np.asarray(samples, dtype=float)
@@ -140,7 +146,7 @@ def error_bound(
     if bound not in ("hoeffding", "bernstein"):
         raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
     if empirical_range:
-        grad_range = float(np.ptp(samples))
+        grad_range = float(np.ptp(samples)) if sample_range is None else float(sample_range)
     elif theoretical_range is not None:
         if not (np.isfinite(theoretical_range) and theoretical_range > 0):
             raise ValueError(f"theoretical_range must be finite and > 0, got {theoretical_range}")
@@ -149,4 +155,4 @@ def error_bound(
         grad_range = gradient_range_bound(constants)
     if bound == "hoeffding":
         return hoeffding(delta, grad_range)
-    return bernstein(delta, float(np.var(samples, ddof=1)), grad_range)
+    return bernstein(delta, float(np.var(samples, ddof=1)) if variance is None else float(variance), grad_range)

@@ -11,7 +11,7 @@ import json
 import warnings
 import zipfile
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
@@ -267,8 +267,9 @@ class _Update:
     next_n: int
 
 
-#: (samples (n, m), their mean, n) -> the update. The loop computes the mean once.
-UpdateRule = Callable[[np.ndarray, np.ndarray, int], _Update]
+#: (samples (n, m), their mean, n, the batch's measured (R, M_phi) or None) -> the update.
+#: The loop computes the mean once.
+UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"], _Update]
 #: ``progress`` of the learning loops: True for a tqdm bar, or a callable ``report(used, budget)``.
 Progress = bool | Callable[[int, int], object]
 
@@ -286,22 +287,33 @@ def _closed_form(task: Task, thetas: np.ndarray, sigma: float) -> np.ndarray:
 
 def _collect(
     task: Task, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator,
-    estimator: Estimator, baseline: bool, score_action: ScoreAction,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Gradient samples (n, m) and measured returns (n,) of a fresh batch.
+    estimator: Estimator, baseline: bool, score_action: ScoreAction, maxima: bool = False,
+) -> tuple[np.ndarray, np.ndarray, tuple[float, float] | None]:
+    """Gradient samples (n, m), measured returns (n,) and, with ``maxima``, the batch's
+    measured (R, M_phi) (else None) of a fresh batch.
 
     Uses the task's fused ``gradient_batch`` when it has one (the LQG and the cart-pole
     do), else simulates the batch and applies :func:`safepg.estimators.gradient_samples`.
     The measured return is the task's ``measured_returns(batch)`` if it defines one (the
     cart-pole: the undiscounted episode length the thesis reports), else the discounted
-    return.
+    return. With ``maxima``: the task's ``gradient_batch_maxima`` if it has one (the
+    cart-pole), else the largest |reward| and |feature| of the simulated batch's live steps.
     """
-    fused = getattr(task, "gradient_batch", None)
-    if fused is not None:
-        return fused(policy, n, rng, estimator, baseline, score_action)
+    if maxima:
+        fused_maxima = getattr(task, "gradient_batch_maxima", None)
+        if fused_maxima is not None:
+            return fused_maxima(policy, n, rng, estimator, baseline, score_action)
+    else:
+        fused = getattr(task, "gradient_batch", None)
+        if fused is not None:
+            return (*fused(policy, n, rng, estimator, baseline, score_action), None)
     batch = task.simulate(policy, n, rng)
     measured = getattr(task, "measured_returns", Trajectories.discounted_returns)
-    return gradient_samples(policy, batch, estimator, baseline, score_action), measured(batch)
+    found = None
+    if maxima:
+        live = np.ones(batch.rewards.shape, dtype=bool) if batch.mask is None else batch.mask.astype(bool)
+        found = (float(np.abs(batch.rewards[live]).max()), float(np.abs(batch.features[live]).max()))
+    return gradient_samples(policy, batch, estimator, baseline, score_action), measured(batch), found
 
 
 def _check_budget(budget: int, n_first: int) -> None:
@@ -323,6 +335,8 @@ def _learn(
     progress: Progress,
     stop_on_divergence: bool = False,
     target_return: float | None = None,
+    update_at_target: bool = False,
+    maxima: bool = False,
 ) -> LearningRecord:
     rng = as_generator(rng)
     theta = policy.theta
@@ -340,7 +354,7 @@ def _learn(
             n = min(n, budget - used)
             if n < 2:
                 break
-            samples, returns = _collect(task, policy, n, rng, estimator, baseline, score_action)
+            samples, returns, found = _collect(task, policy, n, rng, estimator, baseline, score_action, maxima)
             with np.errstate(over="ignore", invalid="ignore"):  # a non-finite mean is handled just below
                 # sum / n is what ndarray.mean computes (same bits), without its Python overhead:
                 # a run with N = 100 has 3*10^5 iterations.
@@ -351,12 +365,12 @@ def _learn(
                     break
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
             J_hat = float(returns.sum() / n)
-            if target_return is not None and J_hat >= target_return:
+            reached = target_return is not None and J_hat >= target_return
+            if reached and not update_at_target:
                 # The policy that produced this batch is the result: record the batch, keep theta.
                 up = _Update(np.zeros_like(grad), 0.0, -1, 0.0, True, n)
-                reached = True
             else:
-                up = rule(samples, grad, n)
+                up = rule(samples, grad, n, found)
             theta = theta + up.delta_theta
             policy = policy.with_theta(theta)
             used += n
@@ -427,6 +441,10 @@ def adaptive_pg(
     score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
     progress: Progress = False,
+    n_first: int | None = None,
+    constants: Literal["bounds", "batch"] = "bounds",
+    statistics: Literal["component", "max"] = "component",
+    step_when_unsafe: bool = False,
 ) -> LearningRecord:
     r"""Adaptive policy gradient, Algorithm 4.1 (as corrected in the book's errata).
 
@@ -435,7 +453,10 @@ def adaptive_pg(
     :math:`\epsilon = d_\delta/\sqrt N + f_\delta/N` from the chosen bound on component k,
     moves :math:`\theta_k` by the step of Corollary 4.2.8, and sets the next batch size to
     N* (Theorem 4.3.2, or the search of Section 4.3.3 for Bernstein) clipped to
-    [n_min, n_max]. The first batch has n_min trajectories.
+    [n_min, n_max]. The first batch has n_min trajectories (``n_first`` to change it).
+
+    The last four parameters default to the algorithm as the theorems need it; the other
+    values are what the authors' 2-D and cart-pole scripts did, to reproduce their runs.
 
     Parameters
     ----------
@@ -456,24 +477,50 @@ def adaptive_pg(
         after each batch with the trajectories used so far. An exception it raises stops
         the run and propagates to the caller, with no record: how a caller running the loop
         in a thread cancels it (one call per batch, so cancelling waits for one batch).
+    n_first : size of the first batch (None: n_min), which no bound chooses (the authors
+        hard-coded 100 in 2-D and 1000 on the cart-pole)
+    constants : "bounds" (default): R and M_phi are the task's bounds (Assumption 4.2.1), as
+        Theorem 4.2.3 needs; "batch": the largest |reward| and |feature| measured on each batch
+        (the authors' cart-pole script), so the penalty constant and the bounds change from
+        batch to batch; the record's ``config["c"]`` is then the bound-based constant
+    statistics : "component" (default): the sample variance and range of component k, as in
+        Section 4.3.3; "max": the largest sample variance and range over all components (the
+        authors' 2-D and cart-pole scripts)
+    step_when_unsafe : take the step of Corollary 4.2.8's formula even when eps >= |g_k|
+        (the authors' scripts); by default the algorithm does not move then
     """
     check_delta(delta)
     if int(n_min) != n_min or n_min < 2:
         raise ValueError(f"n_min must be an integer >= 2, got {n_min}")
     if n_min > n_max:
         raise ValueError(f"n_min must be <= n_max, got n_min={n_min} > n_max={n_max}")
-    _check_budget(budget, n_min)
+    if n_first is not None and (int(n_first) != n_first or n_first < 2):
+        raise ValueError(f"n_first must be an integer >= 2 or None, got {n_first}")
+    if constants not in ("bounds", "batch"):
+        raise ValueError(f"constants must be 'bounds' or 'batch', got {constants!r}")
+    if statistics not in ("component", "max"):
+        raise ValueError(f"statistics must be 'component' or 'max', got {statistics!r}")
+    first = n_min if n_first is None else int(n_first)
+    _check_budget(budget, first)
     policy = _initial_policy(task, theta0, sigma)
-    constants = TaskConstants.from_task(task, policy.sigma)
-    c = penalty_constant(constants)
+    bounds = TaskConstants.from_task(task, policy.sigma)
+    c_bounds = penalty_constant(bounds)
 
-    def rule(samples: np.ndarray, grad: np.ndarray, n: int) -> _Update:
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
         g = float(abs(grad[k]))
-        eb: ErrorBound = error_bound(bound, samples[:, k], delta, constants, estimator, empirical_range,
-                                     theoretical_range)
+        batch_k, c = bounds, c_bounds
+        if found is not None:  # constants="batch": this batch's R and M_phi
+            batch_k = replace(bounds, R=found[0], M_phi=found[1])
+            c = penalty_constant(batch_k)
+        spread = {}
+        if statistics == "max":
+            spread = dict(variance=float(np.var(samples, axis=0, ddof=1).max()),
+                          sample_range=float(np.ptp(samples, axis=0).max()))
+        eb: ErrorBound = error_bound(bound, samples[:, k], delta, batch_k, estimator, empirical_range,
+                                     theoretical_range, **spread)
         eps = float(eb.eps(n))
-        alpha = coordinate_step(g, eps, c)
+        alpha = coordinate_step(g, eps, c, guarded=not step_when_unsafe)
         step = np.zeros_like(grad)
         step[k] = alpha * grad[k]
         return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, n_min, n_max))
@@ -482,9 +529,14 @@ def adaptive_pg(
         algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
         sigma=sigma, estimator=estimator, baseline=baseline, bound=bound, delta=delta,
         empirical_range=empirical_range, theoretical_range=theoretical_range, n_min=n_min, n_max=n_max,
-        budget=budget, score_action=score_action, c=c,
+        budget=budget, score_action=score_action, c=c_bounds,
     )
-    return _learn(task, policy, rule, n_min, budget, rng, estimator, baseline, score_action, config, progress)
+    # The options only when set, so a default run's record is what it always was.
+    config.update({k: v for k, v in (("n_first", n_first), ("constants", constants), ("statistics", statistics),
+                                     ("step_when_unsafe", step_when_unsafe))
+                   if v not in (None, "bounds", "component", False)})
+    return _learn(task, policy, rule, first, budget, rng, estimator, baseline, score_action, config, progress,
+                  maxima=constants == "batch")
 
 
 def vanilla_pg(
@@ -506,6 +558,7 @@ def vanilla_pg(
     progress: Progress = False,
     stop_on_divergence: bool = False,
     target_return: float | None = None,
+    update_at_target: bool = False,
 ) -> LearningRecord:
     r"""Policy gradient with a fixed batch size.
 
@@ -520,7 +573,9 @@ def vanilla_pg(
     ``target_return`` stops the run at the first batch whose mean measured return reaches
     it, without updating (``reached_target``): the protocol that learns the cart-pole
     baseline policy of Section 5.3 ("we stop once an average performance of 195 over the
-    batch is achieved"). ``budget`` then caps the search.
+    batch is achieved"). ``budget`` then caps the search. With ``update_at_target=True``
+    the batch that reaches the target still updates theta before the run stops, as in the
+    authors' baseline script (its saved policy is one update past the batch that reached 195).
 
     ``progress`` is as in :func:`adaptive_pg`: True for a tqdm bar, or a callable
     ``progress(used, budget)`` called after each batch, whose exceptions stop the run.
@@ -540,7 +595,7 @@ def vanilla_pg(
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
 
-    def rule(samples: np.ndarray, grad: np.ndarray, n: int) -> _Update:
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
         eps, safe, a = 0.0, True, alpha
         if alpha is None:
@@ -562,8 +617,10 @@ def vanilla_pg(
         baseline=baseline, bound=bound, delta=delta, empirical_range=empirical_range,
         budget=budget, score_action=score_action, c=c, target_return=target_return,
     )
+    if update_at_target:  # only when set, so a default run's record is what it always was
+        config["update_at_target"] = True
     return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress,
-                  stop_on_divergence, target_return)
+                  stop_on_divergence, target_return, update_at_target)
 
 
 __all__ = ["CHECKPOINTS", "LearningRecord", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]

@@ -46,19 +46,23 @@ def _check_g(g: float) -> float:
     return float(g)
 
 
-def coordinate_step(g: float, eps: float, c: float) -> float:
+def coordinate_step(g: float, eps: float, c: float, guarded: bool = True) -> float:
     r"""Step size of the updated coordinate (Corollary 4.2.8; eps = 0 gives 4.2.4).
 
     .. math:: \alpha_k^* = \frac{(\|\hat\nabla J\|_\infty - \epsilon)^2}
                                 {2c\,(\|\hat\nabla J\|_\infty + \epsilon)^2}
 
     Zero when Assumption 4.2.7 fails (eps >= g): no improvement can be guaranteed, and
-    the saturated bound of Theorem 4.2.6 is then maximised by not moving.
+    the saturated bound of Theorem 4.2.6 is then maximised by not moving. With
+    ``guarded=False`` the formula is evaluated there too (a positive step without any
+    guarantee), as the authors' scripts did.
     """
     g = _check_g(g)
-    if eps >= g:
+    if eps >= g and guarded:
         return 0.0
     lo, hi = g - eps, g + eps
+    if hi == 0:  # g = eps = 0 (unguarded): nothing to follow
+        return 0.0
     return lo * lo / (2 * c * (hi * hi))
 
 

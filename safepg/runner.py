@@ -72,6 +72,11 @@ class RunConfig:
     that enters the key. ``warm_start`` names the run whose final parameters, seed by seed,
     start this one, and ``warm_start_key`` is that run's :meth:`key`, so that a changed
     starting run changes this run's key too.
+
+    The options after ``target_return`` are None unless set, and an unset option stays out
+    of the key (existing runs keep their keys); set, they pass to the learning loop:
+    ``n_first``, ``constants``, ``statistics``, ``step_when_unsafe`` to :func:`adaptive_pg`
+    and ``update_at_target`` to :func:`vanilla_pg` (the authors' ways of running, see there).
     """
 
     name: str
@@ -93,6 +98,11 @@ class RunConfig:
     budget: int = 30_000_000
     score_action: Literal["clipped", "raw"] = "clipped"
     target_return: float | None = None
+    n_first: int | None = None
+    constants: Literal["bounds", "batch"] | None = None
+    statistics: Literal["component", "max"] | None = None
+    step_when_unsafe: bool | None = None
+    update_at_target: bool | None = None
     warm_start: str | None = None
     warm_start_key: str | None = field(default=None, repr=False)
     env_factory: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
@@ -138,14 +148,22 @@ class RunConfig:
                       delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
                       score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
                       progress=progress)
+        options = {k: v for k, v in (("n_first", self.n_first), ("constants", self.constants),
+                                     ("statistics", self.statistics), ("step_when_unsafe", self.step_when_unsafe))
+                   if v is not None}
         if self.algorithm == "adaptive":
+            if self.update_at_target is not None:
+                raise ValueError(f"update_at_target is an option of vanilla runs, not of {self.name!r}")
             return adaptive_pg(env, theta0, self.sigma, n_min=self.n_min, n_max=self.n_max,
-                               theoretical_range=self.theoretical_range, **common)
+                               theoretical_range=self.theoretical_range, **options, **common)
         if self.batch_size is None:
             raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
+        if options:
+            raise ValueError(f"{sorted(options)} are options of adaptive runs, not of {self.name!r}")
         # A fixed step may diverge; that is a result to report, not an error.
         return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
-                          step=self.step, stop_on_divergence=True, target_return=self.target_return, **common)
+                          step=self.step, stop_on_divergence=True, target_return=self.target_return,
+                          update_at_target=bool(self.update_at_target), **common)
 
 
 def run_path(folder: Path, cfg: RunConfig, k: int) -> Path:

@@ -218,3 +218,105 @@ def test_measured_returns_hook_sets_J_hat():
     batch = env.simulate(LinearGaussianPolicy(np.array([[-0.3]]), 1.0), 300, np.random.default_rng(1))
     assert rec.J_hat[0] == pytest.approx(batch.rewards.sum(axis=1).mean(), rel=1e-12)
     assert rec.J_hat[0] != pytest.approx(batch.discounted_returns().mean(), rel=1e-3)
+
+
+# ------------------------------------------------------------------ the authors' ways of running
+ENV2 = LQG.thesis_2d(gamma=0.9)
+
+
+def _first_batch(env, theta0, n, seed):
+    """The first batch an adaptive run with ``rng=seed`` draws: samples and returns."""
+    pol = LinearGaussianPolicy(np.asarray(theta0, float).reshape(env.dim, env.dim), 1.0)
+    return env.gradient_batch(pol, n, np.random.default_rng(seed))
+
+
+def test_n_first_sets_only_the_first_batch():
+    kw = dict(bound="bernstein", empirical_range=True, budget=20_000)
+    rec = adaptive_pg(ENV, n_first=1000, n_min=10, rng=np.random.default_rng(3), **kw)
+    assert rec.batch_size[0] == 1000 and rec.config["n_first"] == 1000
+    # The rest follows N* clipped to [n_min, n_max]; without n_first the first batch is n_min.
+    assert 1000 not in rec.batch_size[1:-1]
+    default = adaptive_pg(ENV, n_min=10, rng=3, **kw)
+    assert default.batch_size[0] == 10 and "n_first" not in default.config
+    with pytest.raises(ValueError, match="^n_first "):
+        adaptive_pg(ENV, n_first=1, budget=1000)
+    with pytest.raises(ValueError, match="^budget "):
+        adaptive_pg(ENV, n_first=2000, budget=1000)
+
+
+def test_statistics_max_uses_the_largest_variance_and_range_over_components():
+    from safepg.bounds import bernstein
+
+    kw = dict(bound="bernstein", empirical_range=True, budget=300, n_first=300)
+    rec = adaptive_pg(ENV2, np.zeros(4), statistics="max", rng=np.random.default_rng(8), **kw)
+    samples, _ = _first_batch(ENV2, np.zeros(4), 300, 8)
+    k = int(rec.coordinate[0])
+    var, rng_ = np.var(samples, axis=0, ddof=1), np.ptp(samples, axis=0)
+    assert rec.eps[0] == pytest.approx(bernstein(0.95, var.max(), rng_.max()).eps(300), rel=1e-12)
+    own = adaptive_pg(ENV2, np.zeros(4), rng=np.random.default_rng(8), **kw)
+    assert own.eps[0] == pytest.approx(bernstein(0.95, var[k], rng_[k]).eps(300), rel=1e-12)
+    assert rec.eps[0] > own.eps[0]  # the maxima are the more conservative choice here
+    with pytest.raises(ValueError, match="^statistics "):
+        adaptive_pg(ENV, statistics="mean", budget=1000)
+
+
+def test_constants_batch_measures_R_and_M_phi_on_each_batch():
+    class Simulated(LQG):
+        """The 1-D LQG without its fused path: the loop measures the maxima on the simulated batch."""
+
+        gradient_batch = None
+
+    env = Simulated(dim=1, gamma=0.9, horizon=20)
+    kw = dict(bound="bernstein", empirical_range=True, budget=400, n_first=400)
+    rec = adaptive_pg(env, -0.5, 0.1, constants="batch", step_when_unsafe=True, rng=np.random.default_rng(2), **kw)
+    batch = env.simulate(LinearGaussianPolicy(np.array([[-0.5]]), 0.1), 400, np.random.default_rng(2))
+    R, M = np.abs(batch.rewards).max(), np.abs(batch.features).max()
+    assert R < env.reward_bound and M < env.feature_bound  # measured values are below the bounds ...
+    bounds = TaskConstants.from_task(env, 0.1)
+    c = penalty_constant(TaskConstants(R, M, bounds.A_volume, bounds.A_bar, 0.9, 20, 0.1))
+    g = abs(rec.grad[0, 0])
+    assert rec.alpha[0] == pytest.approx(coordinate_step(g, rec.eps[0], c, guarded=False), rel=1e-12)
+    # ... so the penalty is smaller and the step larger than with the bounds (config["c"] keeps the latter).
+    assert rec.config["c"] == penalty_constant(bounds) > c
+    with pytest.raises(ValueError, match="^constants "):
+        adaptive_pg(ENV, constants="measured", budget=1000)
+
+
+def test_step_when_unsafe_moves_where_the_algorithm_stops():
+    # Chebyshev at N = 100 from theta = 0: eps exceeds |g| on the first batch.
+    kw = dict(budget=100, rng=0)
+    guarded, unguarded = adaptive_pg(ENV, **kw), adaptive_pg(ENV, step_when_unsafe=True, **kw)
+    assert not guarded.safe[0] and not unguarded.safe[0]
+    assert guarded.alpha[0] == 0.0 and unguarded.alpha[0] > 0.0
+    g, eps = abs(unguarded.grad[0, 0]), unguarded.eps[0]
+    c = penalty_constant(TaskConstants.from_task(ENV, 1.0))
+    assert unguarded.alpha[0] == (g - eps) ** 2 / (2 * c * (g + eps) ** 2)
+    assert coordinate_step(1.0, 2.0, 1.0) == 0.0 and coordinate_step(1.0, 2.0, 1.0, guarded=False) == 1 / 18
+    assert coordinate_step(0.0, 0.0, 1.0, guarded=False) == 0.0
+
+
+def test_update_at_target_updates_before_stopping():
+    kw = dict(batch_size=200, alpha=1e-3, budget=200 * 40, rng=4, target_return=-1e9)
+    kept, updated = vanilla_pg(ENV, -0.1, 1.0, **kw), vanilla_pg(ENV, -0.1, 1.0, update_at_target=True, **kw)
+    assert kept.reached_target and updated.reached_target and kept.iterations == updated.iterations == 1
+    assert kept.theta[-1] == kept.theta[0] and updated.theta[-1] != updated.theta[0]
+    np.testing.assert_allclose(updated.theta[-1] - updated.theta[0], 1e-3 * updated.grad[0])
+    assert updated.config["update_at_target"] is True and "update_at_target" not in kept.config
+
+
+def test_run_config_passes_the_options_and_keeps_unset_keys():
+    from safepg.runner import RunConfig
+
+    plain = RunConfig("a", budget=2000)
+    # The key of a config without the options is the one it had before they existed.
+    assert plain.key() == "26f1a48930414444"
+    opts = RunConfig("a", budget=2000, n_first=500, constants="batch", statistics="max", step_when_unsafe=True)
+    assert len({plain.key(), opts.key(), RunConfig("a", budget=2000, n_first=100).key()}) == 3
+    rec = opts.run(0)
+    assert rec.batch_size[0] == 500
+    assert {k: rec.config[k] for k in ("n_first", "constants", "statistics", "step_when_unsafe")} == {
+        "n_first": 500, "constants": "batch", "statistics": "max", "step_when_unsafe": True}
+    with pytest.raises(ValueError, match="options of adaptive runs"):
+        RunConfig("v", "vanilla", batch_size=100, alpha=1e-3, budget=1000, n_first=200).run(0)
+    with pytest.raises(ValueError, match="^update_at_target "):
+        RunConfig("a", budget=1000, update_at_target=True).run(0)
