@@ -190,3 +190,55 @@ def test_report_lists_the_components_each_method_updated(root):
     assert rows["coordinate"]["components_updated"] == [0, 3]  # only the diagonal moves
     assert rows["scalar"]["components_updated"] == [0, 1, 2, 3]
     assert rows["coordinate"]["improvement_ratio_on"] == "J"
+
+
+# ------------------------------------------------------------------ the authors' settings
+def test_authors_experiments_are_the_library_settings_combined():
+    from safepg.envs.cartpole import CartPole
+    from safepg.thesis.authors import TABLE_5_4_BUDGET, cartpole_theta_star
+
+    t51 = ex.get_experiment("table-5.1-authors")
+    assert t51.rules == "authors" and all(c.theta0 == (-0.575853,) for c in t51.configs)
+    assert [replace(c, theta0=(-0.575,)) for c in t51.configs] == list(ex.get_experiment("table-5.1").configs)
+    base = ex.get_experiment("cartpole-baseline-authors").configs[0]
+    assert ex.make_env(base.env) == CartPole(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9)
+    assert base.update_at_target and (base.batch_size, base.alpha, base.step, base.target_return) == (
+        4000, 0.01, "scalar", 195.0)
+    t54 = ex.get_experiment("table-5.4-authors")
+    ad, fx = t54.config("adaptive"), t54.config("N=4000")
+    assert ex.make_env(ad.env) == CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9,
+                                                          polemass_length=0.05) == ex.make_env(fx.env)
+    assert (ad.n_first, ad.n_min, ad.n_max, ad.constants, ad.statistics, ad.step_when_unsafe) == (
+        1000, 10, 500_000, "batch", "max", True)
+    assert (ad.bound, ad.empirical_range, ad.delta) == ("bernstein", True, 0.95)
+    assert (fx.step, fx.alpha, fx.batch_size) == ("coordinate", 0.01, 4000)
+    assert ad.budget == fx.budget == TABLE_5_4_BUDGET and t54.rules == "authors" and t54.thesis == ex.get_experiment(
+        "table-5.4").thesis
+    assert ad.warm_start == "cartpole-baseline-authors" and ad.warm_start_key == base.key()
+    star = ex.get_experiment("table-5.4-authors-theta-star")
+    assert all(c.warm_start is None and c.theta0 == tuple(cartpole_theta_star()) for c in star.configs)
+    t53 = ex.get_experiment("table-5.3-authors").configs[0]
+    assert replace(t53, n_max=500_000, statistics=None, step_when_unsafe=None) == ex.get_experiment(
+        "table-5.3").config("adaptive")
+
+
+def test_authors_experiment_runs_and_is_counted_their_way(root):
+    from safepg.thesis.authors import budget_average, strict_improvement_ratio
+
+    exp = ex.scaled(ex.get_experiment("table-5.4-authors-theta-star"), seeds=1, budget=12_000)
+    recs = ex.run_experiment(exp, jobs=1, progress=False)
+    ad, fx = recs["adaptive"][0], recs["N=4000"][0]
+    assert ad.batch_size[0] == 1000 and ad.config["constants"] == "batch" and fx.batch_size[0] == 4000
+    assert np.all(np.count_nonzero(np.diff(fx.theta, axis=0), axis=1) <= 1)  # one component per update
+    assert 180 < ad.J_hat[0] < 195  # the authors' first doubled-pole batch: 187.5
+    rows = {r["name"]: r for r in ex.report(exp, recs)["configs"]}
+    for name, rec in (("adaptive", ad), ("N=4000", fx)):
+        window = budget_average(rec.batch_size, rec.J_hat, 12_000)
+        assert rows[name]["rules"] == "authors"
+        assert rows[name]["upsilon_bar"]["mean"] == window["upsilon_bar"]
+        assert rows[name]["improvement_ratio"]["mean"] == window["improvement_ratio"]
+    lqg = ex.scaled(replace(ex.get_experiment("table-5.1-authors"), configs=ex.get_experiment(
+        "table-5.1-authors").configs[:1]), seeds=1, budget=60_000)
+    rec = ex.run_experiment(lqg, jobs=1, progress=False)[lqg.configs[0].name][0]
+    row = ex.report(lqg, {lqg.configs[0].name: [rec]})["configs"][0]
+    assert row["improvement_ratio"]["mean"] == strict_improvement_ratio(rec.J[:-1])  # 5 of 6 batch starts

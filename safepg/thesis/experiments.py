@@ -26,6 +26,7 @@ from safepg.runner import RunConfig, load_configs, run_configs, stored_run
 from safepg.runner import make_env as make_core_env
 from safepg.stats import mean_ci95
 from safepg.store import OnDamaged, results_dir
+from safepg.thesis.authors import TABLE_5_4_BUDGET, budget_average, cartpole_theta_star, strict_improvement_ratio
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
 #: of the printed 0.95, the discount that reproduces the printed theta*, final parameters and
@@ -52,7 +53,11 @@ class Experiment:
 
     ``thesis`` maps a config name to the values the thesis prints for it. ``performance``
     is what the improvement ratio is computed on: the closed-form ``"J"`` (the LQG) or the
-    batch-average return ``"J_hat"`` (the cart-pole, which has no closed form).
+    batch-average return ``"J_hat"`` (the cart-pole, which has no closed form). ``rules``
+    is how :func:`report` counts: ``"ours"`` (the share of updates after which performance
+    did not decrease; Upsilon-bar over all trajectories) or ``"authors"`` (their plot
+    scripts, :mod:`safepg.thesis.authors`: strict increases between the performances at the
+    batch starts; on the cart-pole only the batches that end before the run's budget).
     """
 
     name: str
@@ -61,6 +66,7 @@ class Experiment:
     seeds: int = 5
     thesis: dict[str, dict[str, Any]] = field(default_factory=dict)
     performance: Literal["J", "J_hat"] = "J"
+    rules: Literal["ours", "authors"] = "ours"
 
     def config(self, name: str) -> RunConfig:
         for c in self.configs:
@@ -356,6 +362,74 @@ def _cartpole_sweep() -> Experiment:
                       f"the doubled pole from each setting's baseline, {SWEEP_BUDGET:.0e} trajectories, "
                       f"{SWEEP_SEEDS} seeds.", tuple(configs), SWEEP_SEEDS, thesis, "J_hat")
 
+
+# ------------------------------------------------------------------ the authors' settings
+# What the authors' code ran where the thesis says otherwise or nothing (their repository
+# T3p/adaptive-batch-size: scripts and raw outputs, safepg.thesis.authors). Each setting is a
+# parameter of the library; these experiments combine them.
+
+#: Table 5.1's starting point in every one of the authors' 24 output files.
+AUTHORS_T51_THETA0 = -0.575853
+#: The cart-pole their scripts simulated: gym's 12 degrees, the undiscounted return (their
+#: gamma ** l was typed sigma ** l, with sigma = 1) and gamma = 0.9 in the penalty constant;
+#: doubling the pole kept the 1 m pole's m l = 0.05 (gym caches it before ``length *= 2``).
+AUTHORS_CARTPOLE = {"angle_threshold_deg": 12.0, "gamma": 1.0, "constants_gamma": 0.9}
+AUTHORS_DOUBLED = {**AUTHORS_CARTPOLE, "polemass_length": 0.05}
+#: Their adaptive runs (2-D and cart-pole): the largest sample variance and range over the
+#: components, and the step taken even when eps >= |g_k|.
+_AUTHORS_ADAPTIVE = dict(statistics="max", step_when_unsafe=True)
+
+
+def _authors_cartpole(doubled: bool) -> str:
+    from safepg.envs.cartpole import CartPole
+
+    task = CartPole.thesis_doubled(**AUTHORS_DOUBLED) if doubled else CartPole.thesis(**AUTHORS_CARTPOLE)
+    return task.setting_name()
+
+
+def _table_5_1_authors() -> Experiment:
+    return replace(_table_5_1(AUTHORS_T51_THETA0), name="table-5.1-authors", rules="authors",
+                   description="Table 5.1 as the authors ran and counted it: from theta_0 = -0.575853 (their output "
+                               "files), strict increases of J between batch starts over 10^6/N - 1 updates.")
+
+
+def _table_5_3_authors() -> Experiment:
+    cfg = replace(_table_5_3().config("adaptive"), n_max=100_000, **_AUTHORS_ADAPTIVE)
+    return Experiment("table-5.3-authors", "Table 5.3's adaptive run as the authors' script ran it: N_max = 100000, "
+                      "Bernstein on the largest variance and range over the components, the step taken even when "
+                      "eps >= |g_k|; strict improvement ratio.", (cfg,), 5,
+                      {"adaptive": _table_5_3().thesis["adaptive"]}, rules="authors")
+
+
+def _cartpole_baseline_authors() -> Experiment:
+    base = _cartpole_baseline()
+    cfg = replace(base.configs[0], env=_authors_cartpole(doubled=False), update_at_target=True)
+    return replace(base, name="cartpole-baseline-authors", configs=(cfg,), rules="authors",
+                   description="The cart-pole baseline search on the authors' task (12 deg, undiscounted return): "
+                               "vanilla G(PO)MDP, alpha = 0.01, N = 4000 from theta = 0 until a batch averages 195, "
+                               "that batch's update included (their theta_star).")
+
+
+def _table_5_4_authors(theta_star: bool = False) -> Experiment:
+    # Both runs as long as the authors' adaptive run, the window their table averages over.
+    common: dict[str, Any] = dict(env=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET)
+    if theta_star:
+        common["theta0"] = tuple(float(v) for v in cartpole_theta_star())
+    else:
+        common["warm_start"] = "cartpole-baseline-authors"
+    configs = (RunConfig("adaptive", bound="bernstein", empirical_range=True, n_first=1000, n_min=10,
+                         constants="batch", **_AUTHORS_ADAPTIVE, **common),  # type: ignore[arg-type]
+               RunConfig("N=4000", "vanilla", batch_size=4000, alpha=0.01, step="coordinate", **common))
+    start = "their own baseline policy (theta_star.npy)" if theta_star else "each seed's cartpole-baseline-authors"
+    return Experiment(f"table-5.4-authors{'-theta-star' if theta_star else ''}",
+                      f"Table 5.4 as the authors ran it, from {start}: their doubled pole (m l kept at 0.05), 12 deg, "
+                      "undiscounted return; adaptive with gamma = 0.9 and R, M_phi measured per batch in c, first N = "
+                      "1000, N_min = 10, the maxima over components, unguarded steps; 'vanilla' moving only the "
+                      f"largest component by 0.01 g_k; {TABLE_5_4_BUDGET} trajectories each, counted as "
+                      "plot_cartpole.m.",
+                      configs, 5, _table_5_4().thesis, "J_hat", "authors")
+
+
 def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
     """``exp`` with each config's task factory and the key of the run it warm-starts from."""
     configs = []
@@ -379,7 +453,10 @@ def _registry() -> dict[str, Experiment]:
                    _table_5_2_lemma_range(), _table_5_2_raw_score(), _figures_5_5_5_6(), _table_5_3(),
                    _cartpole_baseline(), _table_5_4(),
                    # The cart-pole sweep's experiments.
-                   *_sweep_baselines(), _cartpole_sweep())
+                   *_sweep_baselines(), _cartpole_sweep(),
+                   # The authors' settings.
+                   _table_5_1_authors(), _table_5_3_authors(), _cartpole_baseline_authors(), _table_5_4_authors(),
+                   _table_5_4_authors(theta_star=True))
     registry = {e.name: e for e in experiments}
     return {name: _bind(e, registry) for name, e in registry.items()}
 
@@ -459,6 +536,16 @@ def load_experiment(exp: Experiment | str, root: Path | None = None,
 
 
 # ------------------------------------------------------------------ report
+def _summary(exp: Experiment, cfg: RunConfig, rec: LearningRecord) -> tuple[float, float]:
+    """(Upsilon-bar, improvement ratio) of one run, counted by the experiment's ``rules``."""
+    if exp.rules == "ours":
+        return rec.upsilon_bar(), rec.improvement_ratio(exp.performance)
+    if exp.performance == "J_hat":  # plot_cartpole.m: the batches that end before the budget
+        window = budget_average(rec.batch_size, rec.J_hat, cfg.budget)
+        return window["upsilon_bar"], window["improvement_ratio"]
+    return rec.upsilon_bar(), strict_improvement_ratio(rec.J[:-1])  # J at the batch starts
+
+
 def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,
            root: Path | None = None) -> dict[str, Any]:
     """One JSON-ready object per configuration, with the thesis's printed values beside ours."""
@@ -482,9 +569,10 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
             "algorithm": c.algorithm, "budget": c.budget,
             "batch_size": c.batch_size, "alpha": c.alpha,
             "seeds": len(recs),
-            "upsilon_bar": mean_ci95(r.upsilon_bar() for r in recs),
-            "improvement_ratio": mean_ci95(r.improvement_ratio(exp.performance) for r in recs),
+            "upsilon_bar": mean_ci95(_summary(exp, c, r)[0] for r in recs),
+            "improvement_ratio": mean_ci95(_summary(exp, c, r)[1] for r in recs),
             "improvement_ratio_on": exp.performance,
+            "rules": exp.rules,
             "J_at": j_at,
             "J_final": float(np.mean([r.J[-1] for r in recs])) if recs and closed_form else None,
             "J_hat_final": float(np.mean([r.J_hat[-1] for r in recs])) if recs else None,
