@@ -7,18 +7,14 @@ Both return a :class:`LearningRecord` of per-iteration arrays. Iteration i colle
 
 from __future__ import annotations
 
-import json
 import warnings
-import zipfile
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
-from pathlib import Path
+from dataclasses import dataclass, replace
 from typing import Any, Literal, Protocol
 
 import numpy as np
 from tqdm.auto import tqdm
 
-from safepg import portable
 from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
 from safepg.constants import BoundedTask, TaskConstants
 from safepg.estimators import Estimator, ScoreAction, gradient_samples
@@ -30,231 +26,13 @@ from safepg.meta import (
     scalar_step,
 )
 from safepg.policies import LinearGaussianPolicy
+from safepg.record import CHECKPOINTS, LearningRecord, RecordFileError
 from safepg.rng import RNGLike, as_generator
 from safepg.trajectories import Trajectories
-
-#: Trajectory counts at which Figures 5.1-5.2 are read off (``LearningRecord.J_at``).
-CHECKPOINTS = (100_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
 
 
 class Task(BoundedTask, Protocol):
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories: ...
-
-
-class RecordFileError(ValueError):
-    """A file that exists but does not hold a readable :class:`LearningRecord`.
-
-    ``path`` is the file and ``reason`` says, in words, what is wrong with it.
-    """
-
-    def __init__(self, path: str | Path, reason: str) -> None:
-        super().__init__(f"{path}: {reason}")
-        self.path, self.reason = Path(path), reason
-
-
-def _damage(err: Exception) -> str:
-    """What is wrong with a run file, in words, from the error that reading it raised."""
-    detail = f"{type(err).__name__}: {err}"
-    if isinstance(err, zipfile.BadZipFile):
-        what = "not a whole .npz archive (truncated or overwritten)"
-    elif isinstance(err, EOFError):
-        what = "empty"
-    elif isinstance(err, ValueError) and "pickle" in str(err):
-        # np.load's message here advises allow_pickle=True, which a damaged file must not get.
-        what, detail = "not an .npz archive (overwritten with other data)", type(err).__name__
-    elif isinstance(err, KeyError | TypeError | AttributeError):
-        what = "not a saved run (an array or the metadata is missing or extra)"
-    elif isinstance(err, json.JSONDecodeError | UnicodeDecodeError):
-        what = "unreadable metadata"
-    else:
-        what = "not a saved run"
-    return f"{what} ({detail})"
-
-
-@dataclass
-class LearningRecord:
-    """Per-iteration record of a learning run (arrays of length I = iterations).
-
-    Attributes
-    ----------
-    batch_size : int array (I,)
-        Trajectories collected at iteration i.
-    alpha : float array (I,)
-        Step size applied (to ``coordinate[i]``, or to every component if -1).
-    coordinate : int array (I,)
-        Updated component k, or -1 for a full (scalar-step) update.
-    theta : float array (I + 1, m)
-        Parameters before each iteration; the last row is the final theta.
-    J : float array (I + 1,)
-        Closed-form expected performance J(theta[i]) (NaN if the task has none).
-    J_hat : float array (I,)
-        Measured performance: mean return of batch i (discounted; for a task with
-        ``measured_returns``, such as the cart-pole, the return that defines).
-    grad : float array (I, m)
-        Gradient estimate of batch i.
-    eps : float array (I,)
-        Estimation error bound used for the step (0 for a fixed step).
-    safe : bool array (I,)
-        Whether the update came with the high-probability improvement guarantee
-        (Assumption 4.2.7 held: eps < |g_k|).
-    config : dict
-        The settings of the run (JSON-serialisable).
-    interrupted : bool
-        The run was stopped early (KeyboardInterrupt); the arrays hold what was done.
-    diverged : bool
-        The run stopped because the gradient estimate overflowed (theta diverged under a
-        fixed step); only with ``stop_on_divergence=True``.
-    reached_target : bool
-        The run stopped because a batch's mean return reached ``target_return``; that
-        last batch made no update, so ``theta_final`` is the policy that reached it.
-    """
-
-    batch_size: np.ndarray
-    alpha: np.ndarray
-    coordinate: np.ndarray
-    theta: np.ndarray
-    J: np.ndarray
-    J_hat: np.ndarray
-    grad: np.ndarray
-    eps: np.ndarray
-    safe: np.ndarray
-    config: dict[str, Any] = field(default_factory=dict)
-    interrupted: bool = False
-    diverged: bool = False
-    reached_target: bool = False
-
-    @property
-    def iterations(self) -> int:
-        return int(self.batch_size.size)
-
-    @property
-    def trajectories(self) -> int:
-        return int(self.batch_size.sum())
-
-    @property
-    def theta_final(self) -> np.ndarray:
-        return self.theta[-1]
-
-    def upsilon_bar(self) -> float:
-        r"""Average performance :math:`\overline\Upsilon` (Tables 5.2-5.4): the measured
-        performance averaged over all trajectories (iterations weighted by batch size)."""
-        # Exact sums (math.fsum), not ``@``: BLAS's dot product differs across CPUs in the last bit.
-        return portable.fsum_mean(self.J_hat, weights=self.batch_size)
-
-    def improvement_ratio(self, on: Literal["J", "J_hat"] = "J") -> float:
-        """Share of policy updates after which performance did not decrease.
-
-        ``on="J"``: the closed-form J (Section 5.1); ``on="J_hat"``: the batch-average
-        return of consecutive batches (Section 5.3, no closed form).
-        """
-        perf = self.J if on == "J" else self.J_hat
-        with np.errstate(invalid="ignore"):  # -inf to -inf (a diverged run) counts as no improvement
-            steps = np.diff(perf)
-        if steps.size == 0:
-            return float("nan")
-        return float(np.mean(steps >= 0))
-
-    def J_at(self, checkpoints: tuple[int, ...] = CHECKPOINTS) -> dict[str, float]:
-        """J of the policy that generated trajectory number T (1-based), for each
-        reached checkpoint T: Figures 5.1-5.2 read at T."""
-        ends = np.cumsum(self.batch_size)
-        out = {}
-        for T in checkpoints:
-            if T <= self.trajectories:
-                out[str(T)] = float(self.J[int(np.searchsorted(ends, T))])
-        return out
-
-    def performance_curve(self) -> tuple[np.ndarray, np.ndarray]:
-        """(trajectories used so far, J) as a step curve, Figures 5.1-5.2."""
-        return np.concatenate([[0], np.cumsum(self.batch_size)]), self.J
-
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready summary of the run."""
-        return {
-            "iterations": self.iterations,
-            "trajectories": self.trajectories,
-            "theta": self.theta_final.tolist(),
-            "J_initial": float(self.J[0]),
-            "J_final": float(self.J[-1]),
-            "J_at": self.J_at(),
-            "upsilon_bar": self.upsilon_bar(),
-            "improvement_ratio": self.improvement_ratio(),
-            "batch_sizes": self.batch_size.tolist(),
-            "interrupted": self.interrupted,
-            "diverged": self.diverged,
-            "reached_target": self.reached_target,
-        }
-
-    def save(self, path: str | Path) -> None:
-        """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
-        arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
-        meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged,
-                           "reached_target": self.reached_target})
-        np.savez_compressed(path, meta=np.array(meta), **arrays)
-
-    def check(self) -> None:
-        """Raise ``ValueError`` unless the arrays have the kinds and lengths of one run.
-
-        With I iterations and m parameters: ``batch_size``, ``alpha``, ``coordinate``,
-        ``J_hat``, ``eps`` and ``safe`` of shape (I,), ``theta`` (I + 1, m), ``J`` (I + 1,)
-        and ``grad`` (I, m); the counts integer, ``safe`` boolean, the rest floating point.
-        The record of every finished run passes; a file that holds anything else is
-        not a run, whatever its archive says.
-        """
-        kinds = {"batch_size": "iu", "alpha": "f", "coordinate": "iu", "theta": "f", "J": "f",
-                 "J_hat": "f", "grad": "f", "eps": "f", "safe": "b"}
-        for name, kind in kinds.items():
-            a = getattr(self, name)
-            if not isinstance(a, np.ndarray) or a.dtype.kind not in kind:
-                raise ValueError(f"{name} must be an array of kind {kind!r}, got {getattr(a, 'dtype', type(a))}")
-        if self.theta.ndim != 2 or self.theta.shape[1] == 0:
-            raise ValueError(f"theta must have shape (iterations + 1, m), got {self.theta.shape}")
-        it, m = self.theta.shape[0] - 1, self.theta.shape[1]
-        shapes = {"batch_size": (it,), "alpha": (it,), "coordinate": (it,), "J": (it + 1,), "J_hat": (it,),
-                  "grad": (it, m), "eps": (it,), "safe": (it,)}
-        for name, shape in shapes.items():
-            if getattr(self, name).shape != shape:
-                raise ValueError(f"{name} must have shape {shape} to match theta {self.theta.shape}, "
-                                 f"got {getattr(self, name).shape}")
-        if not isinstance(self.config, dict):
-            raise ValueError(f"config must be a dict, got {type(self.config).__name__}")
-
-    @classmethod
-    def load(cls, path: str | Path) -> LearningRecord:
-        """Read a record written by :meth:`save`.
-
-        Raises
-        ------
-        RecordFileError
-            The file exists but is not a whole record: empty, truncated, overwritten with
-            something else, missing an array or its metadata, or holding arrays whose
-            lengths do not fit together (:meth:`check`).
-        OSError
-            The file cannot be opened (missing, no permission, a folder): nothing is known
-            about its contents.
-        """
-        try:
-            # Opened here, not by np.load, which leaves its file open when the archive is broken.
-            # allow_pickle=False: a file can only hold plain arrays.
-            with open(path, "rb") as f, np.load(f) as z:
-                meta = json.loads(str(z["meta"]))
-                arrays = {k: z[k] for k in z.files if k != "meta"}
-            rec = cls(**arrays, config=meta["config"], interrupted=bool(meta["interrupted"]),
-                      diverged=bool(meta.get("diverged", False)),
-                      reached_target=bool(meta.get("reached_target", False)))
-        except (FileNotFoundError, PermissionError, IsADirectoryError, MemoryError):
-            raise  # says nothing about the contents
-        except Exception as err:
-            # np.load and zipfile report a damaged file through many types: BadZipFile
-            # (truncated, bad CRC), EOFError (empty), ValueError (pickled or text data),
-            # zlib.error, TypeError (a bare .npy, or an array too many), KeyError and JSON
-            # errors (a missing array or metadata).
-            raise RecordFileError(path, _damage(err)) from err
-        try:
-            rec.check()
-        except ValueError as err:
-            raise RecordFileError(path, f"arrays that do not form one run ({err})") from err
-        return rec
 
 
 @dataclass(frozen=True)
@@ -623,4 +401,4 @@ def vanilla_pg(
                   stop_on_divergence, target_return, update_at_target)
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]
