@@ -6,7 +6,185 @@ of the same setting, from the stored records and the data files, and returns the
 
 from __future__ import annotations
 
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from typing import Literal
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from safepg.envs.lqg import LQG
+from safepg.learning import LearningRecord
+from safepg.stats import t_quantile_975
+from safepg.thesis import authors, plotting
+from safepg.thesis.analysis import performance_on_grid
+
 # ---------------------------------------------------------------- Section 5.1: 1-D fixed-step runs
+#: Table 5.1's cells drawn by default, (sigma, N, alpha): both sigmas at N = 1000, where the
+#: printed ratios are the furthest from 100% and the slip cell (sigma = 1, alpha = 1e-3) lies.
+T51_OVERLAY_CELLS = ((0.5, 1000, 1e-3), (0.5, 1000, 1e-4), (1.0, 1000, 1e-3), (1.0, 1000, 1e-4))
+
+
+def seed_band95(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean over seeds (axis 0) and the 95% Student-t band, point by point.
+
+    The same interval as :func:`safepg.stats.mean_ci95`, for every column at once; a single
+    seed gives a band of zero width. NaN entries (a run that ended earlier) are left out.
+
+    Parameters
+    ----------
+    values : ndarray, shape (seeds, points)
+
+    Returns
+    -------
+    mean, lo, hi : ndarray, shape (points,)
+    """
+    v = np.asarray(values, dtype=float)
+    n = np.sum(~np.isnan(v), axis=0)
+    with warnings.catch_warnings():  # columns with no seed, or one: NaN mean, no band
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean = np.nanmean(v, axis=0)
+        sd = np.where(n > 1, np.nanstd(v, axis=0, ddof=1), 0.0)
+    t = np.array([t_quantile_975(int(k) - 1) if k > 1 else 0.0 for k in n])
+    half = t * sd / np.sqrt(np.maximum(n, 1))
+    return mean, mean - half, mean + half
+
+
+def _t51_name(sigma: float, n: int, alpha: float) -> str:
+    return f"sigma={sigma}-N={n}-alpha={alpha:.0e}"
+
+
+def table51_overlay_series(records: Mapping[str, Sequence[LearningRecord]], cell: tuple[float, int, float],
+                           quantity: Literal["J", "theta"] = "J") -> dict[str, np.ndarray]:
+    """The curves of one Table 5.1 cell: ours (seed mean and 95% band) and the authors' run.
+
+    Both are read at the batch starts, trajectory k N for k = 0, 1, ... The authors' J column
+    reads sigma as a variance (their sigma = 0.5 files start at -7.134), so their J is
+    recomputed from their theta with our closed form at standard deviation sigma, which is
+    their column itself at sigma = 1; theta is theirs as written.
+
+    Parameters
+    ----------
+    records : mapping of config name to records
+        Our runs of a Table 5.1 experiment (``table-5.1`` or ``table-5.1-authors``).
+    cell : (sigma, N, alpha)
+    quantity : "J" or "theta"
+
+    Returns
+    -------
+    dict
+        ``x`` and ``ours_mean``, ``ours_lo``, ``ours_hi`` (ours), ``x_authors`` and ``authors``.
+    """
+    sigma, n, alpha = cell
+    recs = records[_t51_name(sigma, n, alpha)]
+    if not recs:
+        raise ValueError(f"records must hold runs of {_t51_name(sigma, n, alpha)}, got none")
+    length = max(r.iterations + 1 for r in recs)
+    ours = np.full((len(recs), length), np.nan)
+    for i, r in enumerate(recs):
+        ours[i, : r.iterations + 1] = r.J if quantity == "J" else r.theta[:, 0]
+    run = authors.table51_runs()[(sigma, n, alpha)]
+    theirs = run["theta"]
+    if quantity == "J":
+        theirs = LQG.thesis_1d().performance_batch(theirs.reshape(-1, 1), sigma)
+    mean, lo, hi = seed_band95(ours)
+    return {"x": n * np.arange(length), "ours_mean": mean, "ours_lo": lo, "ours_hi": hi,
+            "x_authors": n * np.arange(run.iterations), "authors": np.asarray(theirs, dtype=float)}
+
+
+def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
+                           cells: Sequence[tuple[float, int, float]] = T51_OVERLAY_CELLS,
+                           quantity: Literal["J", "theta"] = "J", label: str = "ours") -> Figure:
+    """Table 5.1's fixed-step runs: ours (mean and 95% band over seeds) over the authors' run.
+
+    One panel per cell (sigma, N, alpha), two columns; J (or theta) against the trajectories
+    at each batch start. The dotted line is the optimum of the closed form.
+
+    Parameters
+    ----------
+    records : mapping of config name to records
+        Our runs of ``table-5.1`` or ``table-5.1-authors``.
+    cells : sequence of (sigma, N, alpha)
+    quantity : "J" or "theta"
+    label : str
+        Legend label of our runs.
+    """
+    rows = math.ceil(len(cells) / 2)
+    fig, axes = plt.subplots(rows, 2, figsize=(7, 2.6 * rows), squeeze=False, sharex=True)
+    env = LQG.thesis_1d()
+    theta_star = float(env.optimal_gain()[0, 0])  # the closed form's optimum, whatever sigma
+    for ax, cell in zip(axes.flat, cells):
+        s = table51_overlay_series(records, cell, quantity)
+        ax.plot(s["x_authors"], s["authors"], color="black", linewidth=0.9, label="authors' run")
+        ax.plot(s["x"], s["ours_mean"], color=plotting.ACCENT, linewidth=1.1, label=label)
+        ax.fill_between(s["x"], s["ours_lo"], s["ours_hi"], color=plotting.ACCENT, alpha=0.25, linewidth=0)
+        best = env.performance(theta_star, cell[0]) if quantity == "J" else theta_star
+        ax.axhline(best, color=plotting.MUTED, linestyle=":", linewidth=0.8)
+        ax.set_title(f"σ = {cell[0]}, N = {cell[1]}, α = {cell[2]:.0e}", fontsize="small")
+        ax.set_ylabel(r"$J(\theta)$" if quantity == "J" else r"$\theta$")
+    for ax in axes.flat[len(cells):]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("trajectories")
+    axes.flat[0].legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config) -> dict[str, np.ndarray]:
+    """One curve of Figures 5.1-5.2: ours (seed mean and 95% band of the closed-form J of the
+    policy that generated trajectory T) and the authors' five-run mean, on their grid of T."""
+    curve = authors.figure51_52_curves()[(config.estimator, config.bound, config.empirical_range, config.delta)]
+    grid = curve["trajectories"].astype(np.int64)
+    mean, lo, hi = seed_band95(performance_on_grid(records[config.name], grid))
+    return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"]}
+
+
+def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
+                       colors: Mapping[str, str], labels: Mapping[str, str]) -> None:
+    for c in configs:
+        s = figure51_52_overlay_series(records, c)
+        ax.plot(s["x"], s["ours_mean"], color=colors[c.name], linewidth=1.6, label=labels[c.name])
+        ax.fill_between(s["x"], s["ours_lo"], s["ours_hi"], color=colors[c.name], alpha=0.25, linewidth=0)
+        # Theirs on top, thin: the two curves mostly coincide.
+        ax.plot(s["x"], s["authors"], color="black", linestyle=(0, (3, 3)), linewidth=0.7)
+    ax.set_xlabel("trajectories")
+    ax.set_ylabel(r"expected performance $J(\theta)$")
+    ax.legend(fontsize="small", title="ours (colour), authors' (black dashed)", title_fontsize="small")
+
+
+def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
+                       ylim: tuple[float, float] | None = None) -> Figure:
+    """Figure 5.1 (Chebyshev, each delta): our ``table-5.2`` runs (mean and 95% band over
+    seeds, in colour) under the authors' five-run means (black, dashed); one panel per estimator."""
+    estimators = [e for e in ("gpomdp", "reinforce") if any(c.estimator == e for c in configs)]
+    fig, axes = plt.subplots(1, len(estimators), figsize=(7, 3.6), squeeze=False, sharey=True)
+    deltas = sorted({c.delta for c in configs})
+    for ax, est in zip(axes[0], estimators):
+        mine = [c for c in configs if c.estimator == est]
+        _figure51_52_panel(ax, records, mine, {c.name: plotting.delta_color(c.delta, deltas) for c in mine},
+                           {c.name: f"δ = {c.delta}" for c in mine})
+        ax.set_title(plotting.ESTIMATOR_LABELS[est], fontsize="small")
+        if ylim is not None:
+            ax.set_ylim(*ylim)
+    fig.tight_layout()
+    return fig
+
+
+def figure_5_2_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
+                       ylim: tuple[float, float] | None = None) -> Figure:
+    """Figure 5.2 (G(PO)MDP, delta = 0.95, each bound): our ``table-5.2`` runs (mean and 95%
+    band over seeds, in colour) under the authors' five-run means (black, dashed)."""
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    _figure51_52_panel(ax, records, configs,
+                       {c.name: plotting.bound_color(c.bound, c.empirical_range) for c in configs},
+                       {c.name: plotting.bound_label(c.bound, c.empirical_range) for c in configs})
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    fig.tight_layout()
+    return fig
 
 
 # ---------------------------------------------------------------- Section 5.2: 2-D runs
