@@ -124,6 +124,7 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
         ax.axhline(best, color=plotting.MUTED, linestyle=":", linewidth=0.8)
         ax.set_title(f"σ = {cell[0]}, N = {cell[1]}, α = {cell[2]:.0e}", fontsize="small")
         ax.set_ylabel(r"$J(\theta)$" if quantity == "J" else r"$\theta$")
+        ax.ticklabel_format(axis="y", useOffset=False)  # J varies in its 4th decimal at sigma = 0.5
     for ax in axes.flat[len(cells):]:
         ax.set_visible(False)
     for ax in axes[-1]:
