@@ -177,9 +177,22 @@ def test_figure_5_7_overlay_draws_the_batch_sizes() -> None:
     theirs = {"adaptive": _authors_run([100, 409, 345], [0.0] * 3)}
     fig = overlays.figure_5_7_overlay(ours, authors_settings=[_record([100, 200], [0.0] * 3)], runs=theirs)
     lines = {ln.get_gid(): ln for ln in fig.axes[0].get_lines()}
-    np.testing.assert_allclose(lines["ours:adaptive"].get_ydata(), [100, 400, 500])
-    np.testing.assert_allclose(lines["ours:adaptive-authors"].get_ydata(), [100, 200])
+    # iteration 3 is drawn by one seed of two: left out
+    np.testing.assert_allclose(lines["ours:adaptive"].get_ydata(), [100, 400, np.nan])
+    np.testing.assert_allclose(lines["ours:adaptive-authors"].get_ydata(), [100, 200, np.nan])
     np.testing.assert_allclose(lines["authors:adaptive"].get_ydata(), [100, 409, 345])
+    np.testing.assert_allclose(lines["authors:adaptive"].get_xdata(), [1, 2, 3])
+
+
+def test_long_runs_are_drawn_as_block_means() -> None:
+    np.testing.assert_allclose(overlays.lqg2d_binned(np.arange(1.0, 8.0), 3), [[2.0, 5.0, 7.0]])
+    ours = {"adaptive": [_record([100 + i for i in range(600)], [0.0] * 601) for _ in range(3)]}
+    fig = overlays.figure_5_7_overlay(ours, runs={"adaptive": _authors_run([200] * 300, [0.0] * 300)})
+    lines = {ln.get_gid(): ln for ln in fig.axes[0].get_lines()}
+    y = lines["ours:adaptive"].get_ydata()
+    assert y.size == 150 and y[0] == pytest.approx(101.5) and y[-1] == pytest.approx(697.5)  # blocks of 4
+    assert np.all(lines["authors:adaptive"].get_ydata()[:75] == 200)
+    assert np.all(np.isnan(lines["authors:adaptive"].get_ydata()[75:]))
 
 
 def test_overlays_on_their_real_runs_end_where_their_files_end() -> None:

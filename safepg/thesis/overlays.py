@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from safepg.learning import LearningRecord
@@ -28,6 +29,16 @@ LQG2D_AUTHORS_SCALE = (2 * LQG2D_BOUND) ** 2
 #: One colour per 2-D method; the authors' run of a method is drawn dashed in its colour.
 _LQG2D_COLORS = {"adaptive": "#7d4fb0", "adaptive-authors": "#c0392b", "N=1000": "#3b6fb6", "N=100": "#d98c2b",
                  "scalar": "#3b6fb6", "coordinate": "#7d4fb0"}
+
+
+#: Our mean is drawn broad and light, their run dashed and dark on top of it, so both stay visible
+#: where they coincide.
+_LQG2D_OURS = {"linewidth": 2.6, "alpha": 0.6}
+_LQG2D_THEIRS = {"linestyle": (0, (4, 3)), "linewidth": 1.3, "zorder": 3}
+
+
+def _lqg2d_dark(key: str) -> tuple[float, float, float]:
+    return tuple(0.55 * c for c in to_rgb(_LQG2D_COLORS.get(key, "#444444")))
 
 
 def lqg2d_band(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -82,11 +93,11 @@ def _lqg2d_performance_figure(ours: Mapping[str, tuple[str, Sequence[LearningRec
     for key, (label, recs) in ours.items():
         mean, lo, hi = lqg2d_band(np.array([lqg2d_held(r.batch_size, r.J, grid) for r in recs]))
         color = _LQG2D_COLORS.get(key)
-        ax.plot(grid, mean, color=color, label=label, gid=f"ours:{key}")
+        ax.plot(grid, mean, color=color, label=label, gid=f"ours:{key}", **_LQG2D_OURS)
         ax.fill_between(grid, lo, hi, color=color, alpha=0.25, linewidth=0)
     for key, (label, run) in theirs.items():
-        ax.plot(grid, lqg2d_held(run["N"], run["J"], grid) / LQG2D_AUTHORS_SCALE, color=_LQG2D_COLORS.get(key),
-                linestyle="--", linewidth=1.2, label=label, gid=f"authors:{key}")
+        ax.plot(grid, lqg2d_held(run["N"], run["J"], grid) / LQG2D_AUTHORS_SCALE, color=_lqg2d_dark(key),
+                label=label, gid=f"authors:{key}", **_LQG2D_THEIRS)
     ax.set_xlabel("trajectories")
     ax.set_ylabel(r"expected performance $J(\theta)$")
     _lqg2d_authors_axis(ax)
@@ -95,24 +106,44 @@ def _lqg2d_performance_figure(ours: Mapping[str, tuple[str, Sequence[LearningRec
     return fig
 
 
+def lqg2d_binned(values: np.ndarray, width: int) -> np.ndarray:
+    """Means of consecutive blocks of ``width`` iterations along the last axis (NaN-aware; a
+    block with no value is NaN), so that per-iteration noise does not hide the trend."""
+    v = np.atleast_2d(np.asarray(values, dtype=float))
+    blocks = -(-v.shape[1] // width)
+    padded = np.full((v.shape[0], blocks * width), np.nan)
+    padded[:, : v.shape[1]] = v
+    with warnings.catch_warnings():  # empty blocks past a run's end: NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(padded.reshape(v.shape[0], blocks, width), axis=2)
+
+
 def _lqg2d_iteration_figure(field: str, ours: Mapping[str, tuple[str, Sequence[LearningRecord]]],
-                            theirs: Mapping[str, tuple[str, AuthorsRun]], ylabel: str, log: bool) -> Figure:
+                            theirs: Mapping[str, tuple[str, AuthorsRun]], ylabel: str, log: bool,
+                            points: int = 150) -> Figure:
+    column = {"batch_size": "N", "alpha": "alpha"}[field]
+    length = max([r.iterations for _, recs in ours.values() for r in recs]
+                 + [run.iterations for _, run in theirs.values()])
+    width = max(1, length // points)
     fig, ax = plt.subplots(figsize=(7, 4))
     for key, (label, recs) in ours.items():
-        length = max(r.iterations for r in recs)
         values = np.full((len(recs), length), np.nan)
         for i, r in enumerate(recs):
             values[i, : r.iterations] = getattr(r, field)
-        mean, lo, hi = lqg2d_band(values)
-        it = np.arange(1, length + 1)
+        binned = lqg2d_binned(values, width)
+        mean, lo, hi = lqg2d_band(binned)
+        # Only where most seeds still run: with one or two seeds left the band is meaningless.
+        few = np.sum(np.isfinite(binned), axis=0) < min(3, len(recs))
+        mean[few] = lo[few] = hi[few] = np.nan
+        it = width * np.arange(mean.size) + (width + 1) / 2
         color = _LQG2D_COLORS.get(key)
-        ax.plot(it, mean, color=color, label=label, gid=f"ours:{key}")
+        ax.plot(it, mean, color=color, label=label, gid=f"ours:{key}", **_LQG2D_OURS)
         ax.fill_between(it, lo, hi, color=color, alpha=0.25, linewidth=0)
-    column = {"batch_size": "N", "alpha": "alpha"}[field]
     for key, (label, run) in theirs.items():
-        ax.plot(np.arange(1, run.iterations + 1), run[column], color=_LQG2D_COLORS.get(key), linestyle="--",
-                linewidth=0.8, alpha=0.8, label=label, gid=f"authors:{key}")
-    ax.set_xlabel("iteration")
+        binned = lqg2d_binned(run[column], width)[0]
+        ax.plot(width * np.arange(binned.size) + (width + 1) / 2, binned, color=_lqg2d_dark(key), label=label,
+                gid=f"authors:{key}", **_LQG2D_THEIRS)
+    ax.set_xlabel("iteration" if width == 1 else f"iteration (means over blocks of {width})")
     ax.set_ylabel(ylabel)
     if log:
         ax.set_yscale("log")
