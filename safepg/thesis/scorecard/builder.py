@@ -67,6 +67,11 @@ class Builder:
                 explanation = "Not computed: the runs behind this row are missing from the results store."
             elif note is not None and not ok:
                 explanation = fill(note.text, self.values)
+            elif status == "open":
+                # No chapter explains this gap yet: say so, and what would settle it.
+                also = ", and so does ours under the authors' settings" if authors_ok is False else ""
+                explanation = (f"Open: ours misses this row's rule{also}, and no chapter explains the gap yet; "
+                               "what is missing is the setting or the run that accounts for it.")
             else:
                 explanation = ""
         explanation = " ".join(t for t in (explanation, slip_note, remark) if t)
