@@ -78,12 +78,18 @@ def _cell(text: str, tex: str) -> str:
 
 
 def _source_link(source: str) -> str:
-    """The authors' file(s) a cell comes from, linked to their repository at that commit."""
+    """The authors' file(s) a cell comes from, as a short link to their repository at that commit
+    (the whole ``path@commit`` is its title and is in the CSV/JSON)."""
     m = re.fullmatch(r"(.+)@([0-9a-f]{7,40})", source)
-    if m is None or "{" in m.group(1):  # a range of files, or a file not in the repository
+    if m is None:  # a file not in their repository
         return f'<span class="sc-src">{html.escape(source)}</span>'
-    url = f"{REPOSITORY}/blob/{m.group(2)}/{m.group(1)}"
-    return f'<a class="sc-src" href="{html.escape(url)}">{html.escape(source)}</a>'
+    path, commit = m.groups()
+    runs = re.search(r"\{1-(\d+)\}", path)
+    if runs:  # several runs: their folder
+        url, label = f"{REPOSITORY}/tree/{commit}/{path.rsplit('/', 1)[0]}", f"{runs.group(1)} files @{commit[:7]}"
+    else:
+        url, label = f"{REPOSITORY}/blob/{commit}/{path}", f"file @{commit[:7]}"
+    return f'<a class="sc-src" href="{html.escape(url)}" title="{html.escape(source)}">{label}</a>'
 
 
 def _authors_cells(r: Row) -> str:
