@@ -397,8 +397,8 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
               heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean, seeds=len(its),
               expected_seeds=base_exp.seeds, **a_cells, **outputs.cartpole("baseline", "iterations").cells(),
               authors_note="Reproduced on the authors' task: gym's 12° termination (cartpole/cartpole.py@b9588b7:42; "
-                           "the thesis prints 41.8°), the undiscounted return (polgrad.py@aadbf5b:178), and the "
-                           "update of the batch that reaches 195 kept.")
+                           "the thesis prints 41.8°), the undiscounted return (cartpole/polgrad.py@aadbf5b:178), and "
+                           "the update of the batch that reaches 195 kept.")
     adaptive = recs54.get("adaptive", [])
     steps = np.concatenate([r.alpha[r.alpha > 0] for r in adaptive] or [np.empty(0)])
     b.values["adaptive_steps"] = f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none"
@@ -419,6 +419,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
                        "-" if a_updated is None else ", ".join(_STATE[i] for i in range(4) if i not in a_updated),
                        lambda *_: not set(a_updated or ()) & set(never))
     theirs = outputs.cartpole_components_updated()
+    b.values["authors_components"] = _said(a_cells)
     b.add(id="section-5.3/components", group="Section 5.3",
           quantity="components of θ the adaptive method never updates", where="Section 5.3, after Table 5.4",
           thesis=", ".join(_STATE[i] for i in never),
@@ -434,8 +435,8 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
                        "steps): only x and dx/dt move, as in their own run.")
     own = _report_row(reps.get(T54_AUTHORS_OWN_BASELINE), "adaptive")
     b.values["t54_own_baseline"] = "(not stored yet)" if own is None or not own["seeds"] else \
-        f"{num(own['upsilon_bar']['mean'], 2)} and {pct(own['improvement_ratio']['mean'])} ({own['seeds']} seeds)"
-    b.values["authors_components"] = _said(a_cells)
+        (f"{num(own['upsilon_bar']['mean'], 2)} and {pct(own['improvement_ratio']['mean'])} ({own['seeds']} of "
+         f"{exps[T54_AUTHORS_OWN_BASELINE].seeds} seeds)")
     _upsilon_table_rows(b, "table-5.4", exp54, rep54, "cartpole", "Table 5.4", "Section 5.3", a54,
                         reps.get(T54_AUTHORS), _t54_output,
                         authors_note="Reproduced on the authors' task and methods, from their baseline policy "
