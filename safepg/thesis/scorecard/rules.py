@@ -154,8 +154,7 @@ NOTES: dict[str, Note] = {
     "table-5.4/": Note(
         "Not reproducible as the thesis describes the task: the steps Theorem 4.2.3 certifies on it "
         "({adaptive_steps}) leave θ where the baseline left it, and the chapter's sweep over every unstated setting "
-        "finds none where it learns or where vanilla PG oscillates as reported. From our own runs of the authors' "
-        "baseline search, their settings give {t54_own_baseline}.", "cartpole", "What the sweep says"),
+        "finds none where it learns or where vanilla PG oscillates as reported.", "cartpole", "What the sweep says"),
     "section-5.3/components": Note(
         "Open: ours also moves {extra} (by at most {extra_move:.0e}); the thesis's constants, which decide "
         "which component is updated, are not given; under the authors' settings (their per-batch constants) the "

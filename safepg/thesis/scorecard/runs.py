@@ -261,15 +261,18 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
 def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[str, Any], page: str,
                         heading: str, group: str, authors: Experiment | None = None,
                         authors_rep: Mapping[str, Any] | None = None,
-                        output: Callable[[str, str], outputs.Output] | None = None, authors_note: str = "") -> None:
+                        output: Callable[[str, str], outputs.Output] | None = None, authors_note: str = "",
+                        also: tuple[Experiment, Mapping[str, Any]] | None = None) -> None:
     """Average performance and improvement ratio of each method of Table 5.3 or 5.4: ours, ours under
-    the authors' settings (``authors``, matched by config name) and ``output(config, quantity)``."""
+    the authors' settings (``authors``, matched by config name) and ``output(config, quantity)``;
+    ``also``: another run of the authors' settings, quoted in the row's explanation."""
     dec = TABLE_DECIMALS[table]
     fmt = lambda x: num(x, dec)  # noqa: E731
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
         method = "adaptive N" if c.batch_size is None else f"N = {c.batch_size}"
         ar = _report_row(authors_rep, c.name)
+        other = _report_row(also[1], c.name) if also else None
         if "upsilon_bar" in th:
             text = fmt(th["upsilon_bar"])
             mean, ci = _mean_ci(r["upsilon_bar"])
@@ -284,7 +287,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
                   expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
                   authors_note=authors_note, slip_note="" if out is None else _slip(out, text, fmt),
-                  remark=_missing(out),
+                  remark=_missing(out) or _also(also, other, "upsilon_bar", fmt),
                   **a_cells, **(out.cells() if out else {}))
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
@@ -303,8 +306,21 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   seeds=r["seeds"], expected_seeds=exp.seeds,
                   fields={"method": c.name, "quantity": "improvement_ratio"}, authors_note=authors_note,
                   slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
-                  remark=_missing(out),
+                  remark=_missing(out) or _also(also, other, "improvement_ratio", pct),
                   **a_cells, **(out.cells() if out else {}))
+
+
+def _also(also: tuple[Experiment, Mapping[str, Any]] | None, row: Mapping[str, Any] | None, key: str,
+          fmt: Callable[[float], str]) -> str:
+    """The sentence quoting another run of the authors' settings (``also``) for this row."""
+    if also is None:
+        return ""
+    exp = also[0]
+    if row is None or not row["seeds"] or row[key]["mean"] is None:
+        return f"Under the authors' settings from our own runs of their baseline search ({exp.name}): not stored yet."
+    m, ci = _mean_ci(row[key])
+    return (f"Under the authors' settings from our own runs of their baseline search ({exp.name}): "
+            f"{fmt(m)}{ci_text(ci, fmt)} ({row['seeds']} of {exp.seeds} seeds).")
 
 
 def _missing(out: outputs.Output | None) -> str:
@@ -433,10 +449,6 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
           authors_note="Reproduced with the authors' adaptive run (their doubled pole at 12°, undiscounted, "
                        "γ = 0.9 and R, M_φ measured per batch in c, the maxima over components, unguarded "
                        "steps): only x and dx/dt move, as in their own run.")
-    own = _report_row(reps.get(T54_AUTHORS_OWN_BASELINE), "adaptive")
-    b.values["t54_own_baseline"] = "(not stored yet)" if own is None or not own["seeds"] else \
-        (f"{num(own['upsilon_bar']['mean'], 2)} and {pct(own['improvement_ratio']['mean'])} ({own['seeds']} of "
-         f"{exps[T54_AUTHORS_OWN_BASELINE].seeds} seeds)")
     _upsilon_table_rows(b, "table-5.4", exp54, rep54, "cartpole", "Table 5.4", "Section 5.3", a54,
                         reps.get(T54_AUTHORS), _t54_output,
                         authors_note="Reproduced on the authors' task and methods, from their baseline policy "
@@ -444,7 +456,9 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
                                      "0.05), undiscounted return, γ = 0.9 and per-batch R, M_φ in c, first N = 1000, "
                                      "the maxima over components, unguarded steps; their 'vanilla' moves only the "
                                      "largest component; both averaged over 1151669 trajectories as "
-                                     "plot_cartpole.m@54d92b0 does.")
+                                     "plot_cartpole.m@54d92b0 does.",
+                        also=(exps[T54_AUTHORS_OWN_BASELINE], reps[T54_AUTHORS_OWN_BASELINE])
+                        if T54_AUTHORS_OWN_BASELINE in exps else None)
 
 
 def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapping[str, Any]],
