@@ -20,7 +20,7 @@ import sympy as sp
 from safepg import theory
 from safepg.thesis import errata
 from safepg.thesis import scorecard as sc
-from safepg.thesis.experiments import get_experiment, scaled
+from safepg.thesis.experiments import get_experiment, run_experiment, scaled
 from safepg.thesis.scorecard import links as sc_links
 from safepg.thesis.scorecard.builder import Builder
 
@@ -29,16 +29,24 @@ BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2
 
 def tiny_experiments() -> dict:
     exps = {n: scaled(get_experiment(n), seeds=2, budget=4000) for n in sc.NEEDED}
-    exps["table-5.1"] = scaled(get_experiment("table-5.1"), seeds=2, budget=10_000)  # >= its largest batch
-    for n in sc.RANGE_VARIANTS + sc.THETA0_VARIANTS:
+    for n in ("table-5.1", "table-5.1-printed-theta0", "table-5.1-authors"):
+        # >= twice its largest batch: the authors' count needs two batch starts.
+        exps[n] = scaled(get_experiment(n), seeds=2, budget=20_000)
+    for n in sc.RANGE_VARIANTS:
         try:
-            exps[n] = scaled(get_experiment(n), seeds=2, budget=10_000 if n.startswith("table-5.1") else 4000)
+            exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
         except ValueError:  # not defined by this version of the library
             continue
-    exps["cartpole-baseline"] = scaled(get_experiment("cartpole-baseline"), seeds=2, budget=8000)
-    e54 = exps["table-5.4"]
-    exps["table-5.4"] = replace(e54, configs=tuple(replace(c, warm_start=None, theta0=(0.0,) * 4, budget=8000)
-                                                   for c in e54.configs))
+    exps["table-5.3-authors"] = scaled(get_experiment("table-5.3-authors"), seeds=2, budget=4000)
+    for n in ("cartpole-baseline", "cartpole-baseline-authors"):
+        exps[n] = scaled(get_experiment(n), seeds=2, budget=8000)
+    # The doubled-pole runs start from theta = 0 (no baseline search); 16000 trajectories give the
+    # authors' count two batches of the vanilla N = 4000 before the budget.
+    for n, budget in (("table-5.4", 8000), ("table-5.4-authors", 16_000), ("table-5.4-authors-theta-star", 16_000)):
+        e = get_experiment(n)
+        exps[n] = replace(e, seeds=2, configs=tuple(replace(c, warm_start=None, warm_start_key=None,
+                                                            theta0=c.theta0 if c.warm_start is None else (0.0,) * 4,
+                                                            budget=budget) for c in e.configs))
     return exps
 
 
@@ -46,6 +54,8 @@ def tiny_experiments() -> dict:
 def store(tmp_path_factory):
     root = tmp_path_factory.mktemp("store")
     exps = tiny_experiments()
+    for n in sc.AUTHORS_VARIANTS:  # read, never computed, by the scorecard
+        run_experiment(exps[n], root=root, jobs=1, progress=False)
     rows = sc.scorecard(root, run=True, experiments=exps, jobs=1)
     return root, exps, rows
 
@@ -128,32 +138,144 @@ def test_status_follows_rule_and_note(monkeypatch):
     assert got[0] == ("reproduced", "")
     assert got[1] == ("differs (explained)", "Because of a reason.")
     assert got[2] == ("open", "Open: a reason.")
-    assert got[3] == ("open", "")
+    assert got[3][0] == "open" and got[3][1].startswith("Open: ours misses this row's rule")
     assert got[4][0] == "open" and "Not computed" in got[4][1]
     assert got[5][0] == "open"
     # A failing row links where its explanation points; a reproduced one where it is discussed.
     assert b.rows[0].link.startswith("lqg2d.html#") and b.rows[1].link.startswith("lqg1d.html#table-5-1")
+    assert [r.judged_on for r in b.rows] == ["ours", "ours", "ours", "ours", "", ""]
     with pytest.raises(ValueError, match="rule"):
         b.add(id="x/bad", ok=True, **{**common, "rule": "nope"})
 
 
-def test_status_is_the_rule_applied(rows):
+def test_status_judged_on_the_authors_column(monkeypatch):
+    monkeypatch.setitem(sc.NOTES, "y/explained", sc.Note("Because.", "lqg1d", "Table 5.1"))
+    b = Builder()
+    common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
+                  rule="rounded", page="lqg2d", heading="Table 5.3", authors="1.0", authors_note="Their θ0 did it.")
+    b.add(id="y/both", ok=True, authors_ok=True, **common)  # ours first: the text's settings suffice
+    b.add(id="y/authors", ok=False, authors_ok=True, **common)
+    b.add(id="y/explained", ok=False, authors_ok=False, **common)
+    b.add(id="y/none", ok=False, authors_ok=None, **common)  # authors' runs missing: judged on ours alone
+    b.add(id="y/slip", ok=True, slip_note="Slip: 37.64% against 37.4%.", **common)
+    got = [(r.status, r.judged_on, r.explanation) for r in b.rows]
+    assert got[0] == ("reproduced", "ours", "")
+    assert got[1] == (sc.AUTHORS_STATUS, "authors' settings", "Their θ0 did it.")
+    assert got[2] == ("differs (explained)", "ours", "Because.")
+    assert got[3][:2] == ("open", "ours") and "no chapter explains" in got[3][2]
+    assert got[4][0] == "reproduced" and b.rows[4].slip and "37.64%" in got[4][2]
+    assert not any(r.slip for r in b.rows[:4])
+    assert sc.AUTHORS_STATUS in sc.STATUSES and "authors'" in sc.AUTHORS_STATUS and "only" in sc.AUTHORS_STATUS
+    assert sc.AUTHORS_STATUS in sc.STATUS_RULE
+
+
+def test_slip_is_neither_rounding_nor_truncation():
+    assert sc.is_slip(37.64, "37.4") and sc.is_slip(-0.0136766, "-0.014676")
+    assert not sc.is_slip(37.44, "37.4") and not sc.is_slip(-0.0136782, "-0.013678")
+    assert not sc.is_slip(1.475e-6, "1.4e-06")  # a truncation, one unit of the last digit at most
+    assert sc.is_slip(1.51e-6, "1.4e-06")
+
+
+def test_status_is_the_rule_applied(store):
+    _, exps, rows = store
     for r in rows:
-        assert r.status in sc.STATUSES
-        if r.status == "differs (explained)":
-            assert r.explanation, r.id
-        if r.rule == "ratio-points" and r.ours_value is not None:
+        assert r.status in sc.STATUSES and r.judged_on in (*sc.JUDGED_ON, ""), r.id
+        if r.status in ("differs (explained)", "open", sc.AUTHORS_STATUS):
+            assert r.explanation, r.id  # no failing row without its sentence
+        judged = r.authors_experiment in exps and r.authors_seeds == exps[r.authors_experiment].seeds
+        if r.rule == "ratio-points" and r.ours_value is not None and r.seeds:
             ok = abs(r.ours_value - r.thesis_value) * 100 <= sc.RATIO_POINTS + 1e-9
             assert (r.status == "reproduced") == ok, r.id
+            if not ok and judged:
+                a_ok = abs(r.authors_value - r.thesis_value) * 100 <= sc.RATIO_POINTS + 1e-9
+                assert (r.status == sc.AUTHORS_STATUS) == a_ok, r.id
         if r.rule == "ci-overlap" and r.ours_ci95 is not None:
             lo, hi = sorted(r.fields["thesis_ci95"])
             ok = r.ours_ci95[0] <= hi and lo <= r.ours_ci95[1]
             assert (r.status == "reproduced") == ok, r.id
+        if r.status == sc.AUTHORS_STATUS:
+            assert r.judged_on == "authors' settings" and r.authors not in ("", "-"), r.id
+        if r.status == "reproduced":
+            assert r.judged_on == "ours", r.id
+
+
+def test_rows_carry_the_authors_columns(store):
+    _, exps, rows = store
+    ids = by_id(rows)
+    t51 = [r for r in rows if r.id.startswith("table-5.1/")]
+    assert len(t51) == 24
+    for r in t51:  # ours from the printed theta_0, the authors' settings beside, their output
+        assert r.fields["theta0"] == -0.55 and r.authors_experiment == "table-5.1-authors" and r.authors_seeds == 2
+        assert r.authors_output.endswith(("/99)", "/999)", "/9999)")) and r.authors_output_source.startswith(
+            "lqg/results/final/rate_N")
+    for rid in ("table-5.3/adaptive/upsilon", "table-5.3/adaptive/improvement-ratio"):
+        assert ids[rid].authors_experiment == "table-5.3-authors" and ids[rid].authors not in ("", "-")
+    assert ids["table-5.3/adaptive/upsilon"].authors_output == "-20.4973"
+    for rid in ("table-5.4/adaptive/upsilon", "table-5.4/N=4000/improvement-ratio"):
+        assert ids[rid].authors_experiment == "table-5.4-authors" and ids[rid].authors not in ("", "-")
+        assert "table-5.4-authors-theta-star" in ids[rid].explanation or ids[rid].status == sc.AUTHORS_STATUS
+    assert ids["table-5.4/adaptive/upsilon"].authors_output == "193.1249"
+    assert ids["table-5.4/N=4000/improvement-ratio"].authors_output == "44.76% (128/286)"
+    assert ids["section-5.3/baseline-iterations"].authors_experiment == "cartpole-baseline-authors"
+    assert ids["section-5.3/baseline-iterations"].authors_output == "72"
+    # The Table 5.2 theoretical-range rows: Lemma 4.3.3's range as ours, the authors' 1280 beside.
+    for rid in ("table-5.2/gpomdp-hoeffding-delta=0.95", "table-5.2/gpomdp-bernstein-delta=0.95"):
+        assert ids[rid].fields["theoretical_range"] is None and ids[rid].authors_experiment == "table-5.2"
+    assert ids["table-5.2/gpomdp-bernstein-delta=0.95"].authors_output == "-10.2159 [-10.2162; -10.2155]"
+
+
+def test_a_row_judged_on_the_authors_column(rows):
+    # The 2-D J(theta*): only the authors' formula (16 x the expectation, gamma = 0.9) gives -422.616.
+    j = by_id(rows)["section-5.2/J-star"]
+    assert j.status == sc.AUTHORS_STATUS and j.judged_on == "authors' settings"
+    assert j.authors_value == pytest.approx(-422.61602, abs=1e-5) and j.ours_value == pytest.approx(-26.4135, abs=1e-4)
+    assert "16 times the expectation" in j.explanation and "lqgnd/lqgnd.py@92ac378" in j.explanation
+
+
+def test_slips_are_named_with_both_numbers(rows):
+    ids = by_id(rows)
+    t51 = ids["table-5.1/sigma=1/N=1000/alpha=1e-03"]
+    assert t51.slip and "37.64%" in t51.explanation and "37.4%" in t51.explanation
+    assert t51.authors_output_value == pytest.approx(376 / 999)
+    th = ids["section-5.2/theta-final-scalar/11"]
+    assert th.slip and "-0.0136766" in th.explanation and "-0.014676" in th.explanation
+    assert th.status == "differs (explained)"
+    # A truncated print (1.475e-6 printed 1.4e-06) is not a slip; nor are the other cells of Table 5.1.
+    assert not ids["section-5.2/theta-final-scalar/12"].slip
+    assert [r.id for r in rows if r.slip and r.id.startswith("table-5.")] == [t51.id]
+
+
+def test_open_rows_say_what_evidence_is_missing(rows):
+    ids = by_id(rows)
+    for r in rows:
+        if r.status == "open":
+            assert len(r.explanation) > 40, r.id
+    # Table 5.3's N = 100 run: the authors' file was committed, its blob is not in their repository.
+    for q in ("upsilon", "improvement-ratio"):
+        r = ids[f"table-5.3/N=100/{q}"]
+        assert r.authors_output == "not in their repository" and r.authors_output_value is None
+        assert "2b2178b" in r.explanation and "absent" in r.explanation
+    theta22 = ids["section-5.2/theta-final-scalar/22"]
+    if theta22.status == "open":
+        assert "What is missing" in theta22.explanation and "-0.0136782" in theta22.explanation
+
+
+def test_authors_runs_missing_or_partial_are_shown_not_judged(store):
+    root, exps, _ = store
+    more = dict(exps)
+    more["table-5.1-authors"] = replace(exps["table-5.1-authors"], seeds=3)  # one seed missing
+    rows = sc.scorecard(root, run=False, experiments=more)
+    t51 = [r for r in rows if r.id.startswith("table-5.1/")]
+    assert all("2 of 3 seeds: not judged" in r.authors and r.status != sc.AUTHORS_STATUS for r in t51)
+    empty = sc.scorecard(root / "nothing", run=False, experiments=exps)
+    assert all(r.authors in ("", "-") for r in empty if r.id.startswith(("table-5.", "section-5.3")))
+    assert not any(r.status == sc.AUTHORS_STATUS for r in empty if r.id.startswith("table-5."))
 
 
 def test_cartpole_table_is_settled_by_the_sweep(rows):
-    # The chapter's sweep settles Table 5.4 as not reproducible: a failing cell is explained, and links there.
-    failing = [r for r in rows if r.id.startswith("table-5.4/") and r.status != "reproduced"]
+    # The chapter's sweep settles Table 5.4 as described as not reproducible: a cell that fails on
+    # both columns is explained, and links there.
+    failing = [r for r in rows if r.id.startswith("table-5.4/") and r.status not in ("reproduced", sc.AUTHORS_STATUS)]
     assert failing
     for r in failing:
         assert r.status == "differs (explained)", r.id
@@ -214,6 +336,8 @@ def test_every_printed_result_has_a_row(store):
                 "section-5.1/improvement-ratio-adaptive"):
         assert rid in ids
     assert ids["section-5.2/J-star"].thesis_value == -422.616
+    assert all(ids[f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"].fields["theta0"] == -0.55
+               for c in exps["table-5.1-printed-theta0"].configs)
     assert ids["section-5.2/theta-star"].thesis_value == -0.588
     assert set(r.group for r in rows) == set(sc.GROUPS)
 
@@ -232,6 +356,7 @@ def test_missing_runs_are_open_not_reproduced(tmp_path):
     rows = sc.scorecard(tmp_path, run=False, experiments=exps)
     measured = [r for r in rows if r.id.startswith(("table-5.", "figures-5.5", "section-5.3/"))]
     assert measured and all(r.status == "open" and r.ours_value is None for r in measured)
+    assert all(r.explanation for r in measured)
 
 
 def test_unknown_experiment_name_is_refused():
@@ -246,6 +371,8 @@ def test_every_row_links_to_a_section_of_the_book(rows):
         assert m, (r.id, r.link)
         page, anchor = m.groups()
         assert page in BOOK_PAGES, r.id
+        if r.status == sc.AUTHORS_STATUS and not anchor:
+            continue  # the chapter's section on the authors' settings, while it has no heading of that name
         assert anchor, f"{r.id} links to {page} without an anchor"
         headings = [sc_links.heading_id(text) for _, text in sc_links._headings(page)]
         assert anchor in headings, (r.id, r.link)
@@ -281,7 +408,18 @@ def test_json_and_csv_round_trip(rows, tmp_path):
         assert len(table) == n and all(t["id"].startswith(f"table-5.{k}/") for t in table)
         assert len(json.loads(files[f"table-5.{k}.json"].read_text())["rows"]) == n
     t51 = sc.read_csv(files["table-5.1.csv"])
-    assert {"sigma", "N", "alpha", "thesis", "ours", "status"} <= set(t51[0])
+    assert {"sigma", "N", "alpha", "thesis", "ours", "status", "judged_on", "authors", "authors_output",
+            "authors_output_source", "slip"} <= set(t51[0])
+    new_columns = {"judged_on", "authors", "authors_value", "authors_ci95_low", "authors_ci95_high", "authors_seeds",
+                   "authors_experiment", "authors_output", "authors_output_value", "authors_output_source", "slip"}
+    assert new_columns <= set(sc.CSV_COLUMNS) and new_columns <= set(csv_rows[0])
+    for d, r in zip(csv_rows, rows):
+        assert d["judged_on"] == r.judged_on and d["authors"] == r.authors and d["slip"] == str(r.slip)
+        assert d["authors_output"] == r.authors_output
+        if r.authors_ci95:
+            assert float(d["authors_ci95_low"]) == r.authors_ci95[0]
+    t51json = json.loads(files["table-5.1.json"].read_text())["rows"]
+    assert all("authors_output" in d and "judged_on" in d for d in t51json)
 
 
 def test_counts_and_html(rows):
@@ -291,6 +429,14 @@ def test_counts_and_html(rows):
     assert sum(sum(v.values()) for g, v in c.items() if g != "all") == len(rows)
     page = sc.summary_html(rows) + "".join(sc.group_html(rows, g) for g in sc.GROUPS)
     assert page.count("<tr class=\"sc-row\" data-id=") == len(rows)
+    judged = sum(r.judged_on == "authors' settings" for r in rows)
+    assert judged and page.count('data-judged-on="authors&#x27; settings"') == judged
+    assert all(s.replace("'", "&#x27;") in page for s in sc.STATUSES)
+    # The authors' columns appear in the groups of Chapter 5 only (the closed forms have none).
+    assert "authors&#x27; output" in sc.group_html(rows, "Section 5.1")
+    assert "authors&#x27; output" not in sc.group_html(rows, "Appendix B")
+    assert 'class="sc-slip"' in sc.group_html(rows, "Section 5.1")
+    assert "https://github.com/T3p/adaptive-batch-size/blob/47aac1b/lqg/results/final/" in page
     assert page.count('class="sc-scroll"') == len(sc.GROUPS) + 1 and page.count("<style>") == 1
     assert all(f'href="{r.link}"' in page for r in rows)
 
@@ -299,10 +445,10 @@ def test_reconstructed_settings_are_said(rows):
     t51 = [r for r in rows if r.id.startswith("table-5.1/")]
     assert t51
     for r in t51:
-        if r.status == "reproduced" and r.fields["theta0"] != -0.55:
-            assert "-0.55" in r.explanation and "reconstruction" in r.explanation, r.id
+        if r.status == sc.AUTHORS_STATUS:  # which setting did it, and our reconstruction beside
+            assert "-0.55" in r.explanation and "-0.575853" in r.explanation and "reconstruction" in r.explanation
         if r.status == "open":
-            assert f"{r.fields['theta0']:g}" in r.explanation, r.id
+            assert "-0.55" in r.explanation and "-0.575853" in r.explanation, r.id
 
 
 def test_partly_computed_store_is_not_judged(store):

@@ -26,6 +26,7 @@ from safepg.runner import RunConfig, load_configs, run_configs, stored_run
 from safepg.runner import make_env as make_core_env
 from safepg.stats import mean_ci95
 from safepg.store import OnDamaged, results_dir
+from safepg.thesis import authors
 from safepg.thesis.authors import TABLE_5_4_BUDGET, budget_average, cartpole_theta_star, strict_improvement_ratio
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
@@ -546,9 +547,21 @@ def _summary(exp: Experiment, cfg: RunConfig, rec: LearningRecord) -> tuple[floa
     return rec.upsilon_bar(), strict_improvement_ratio(rec.J[:-1])  # J at the batch starts
 
 
+def _authors_output(exp: Experiment, cfg: RunConfig) -> dict[str, Any] | None:
+    """The authors' own output for ``cfg`` of an authors-settings experiment (their files, recomputed)."""
+    base = authors.cartpole_runs()["baseline"] if exp.rules == "authors" else None
+    out = {"table-5.1-authors": lambda: authors.table_5_1().get((cfg.sigma, cfg.batch_size, cfg.alpha)),
+           "table-5.3-authors": lambda: authors.table_5_3().get(cfg.name),
+           "cartpole-baseline-authors": lambda: {"iterations": base.iterations, "J_hat_final": base["J_hat"][-1]},
+           "table-5.4-authors": lambda: authors.table_5_4()["adaptive" if cfg.algorithm == "adaptive" else "fixed"]}
+    got = out.get(exp.name.removesuffix("-theta-star"), lambda: None)() if base is not None else None
+    return None if got is None else {k: np.asarray(v).tolist() for k, v in got.items()}
+
+
 def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,
            root: Path | None = None) -> dict[str, Any]:
-    """One JSON-ready object per configuration, with the thesis's printed values beside ours."""
+    """One JSON-ready object per configuration, with the thesis's printed values beside ours (and,
+    for the authors' settings, ``authors_output``: their own raw output recomputed)."""
     exp = get_experiment(exp) if isinstance(exp, str) else exp
     records = load_experiment(exp, root) if records is None else records
     rows = []
@@ -581,5 +594,6 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
             "components_updated": updated,
             "diverged": sum(r.diverged for r in recs),
             "thesis": exp.thesis.get(c.name),
+            "authors_output": _authors_output(exp, c),
         })
     return {"experiment": exp.name, "configs": rows}

@@ -13,9 +13,13 @@ One :class:`Row` per printed result, built from the same sources the chapters us
   :func:`safepg.thesis.errata.errata`.
 
 No number is typed here except the printed values no other module records yet
-(:data:`PRINTED`). Each row gets a status by a stated rule (:data:`RULES`):
-``"reproduced"`` when the rule holds; otherwise ``"differs (explained)"`` when the chapter
-explains the gap (the sentence is kept with the row, :data:`NOTES`), else ``"open"``.
+(:data:`PRINTED`). Each row gets a status by a stated rule (:data:`RULES`, :data:`STATUS_RULE`):
+``"reproduced"`` when the rule holds on ours (the thesis's text); otherwise
+:data:`AUTHORS_STATUS` when it holds on ours under the authors' settings (the ``*-authors``
+experiments, :data:`AUTHORS_VARIANTS`, and their 2-D J); otherwise ``"differs (explained)"``
+when the chapter explains the gap (the sentence is kept with the row, :data:`NOTES`), else
+``"open"`` with what evidence is missing. Beside them, the authors' own raw output recomputed
+(:mod:`~safepg.thesis.scorecard.outputs`), and a named slip where the print is not their output.
 
 :func:`scorecard` builds the rows (``run=True`` computes missing runs first),
 :func:`write_scorecard` exports them and each thesis table to CSV and JSON, and
@@ -31,6 +35,7 @@ Modules (their public names used outside the package are available here):
 - :mod:`~safepg.thesis.scorecard.closed_forms`: the rows of the printed statements and the LQG's
   closed forms;
 - :mod:`~safepg.thesis.scorecard.runs`: the rows of the Chapter 5 runs;
+- :mod:`~safepg.thesis.scorecard.outputs`: the authors' raw outputs beside the rows;
 - :mod:`~safepg.thesis.scorecard.rows`: :func:`scorecard`, every row;
 - :mod:`~safepg.thesis.scorecard.export`: :func:`counts`, the CSV and JSON files;
 - :mod:`~safepg.thesis.scorecard.page`: the scorecard page's HTML.
@@ -49,9 +54,11 @@ from safepg.thesis.scorecard.export import (
 )
 from safepg.thesis.scorecard.links import BOOK, book_link
 from safepg.thesis.scorecard.page import group_html, summary_html
-from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS, THETA0_VARIANTS, scorecard
+from safepg.thesis.scorecard.rows import AUTHORS_VARIANTS, NEEDED, RANGE_VARIANTS, THETA0_VARIANTS, scorecard
 from safepg.thesis.scorecard.rules import (
+    AUTHORS_STATUS,
     GROUPS,
+    JUDGED_ON,
     NOTES,
     PRINTED,
     RATIO_POINTS,
@@ -66,15 +73,16 @@ from safepg.thesis.scorecard.rules import (
     in_seed_range,
     in_widened_interval,
     intervals_overlap,
+    is_slip,
     order_of_magnitude,
     within_points,
     within_rounding,
 )
 
 __all__ = [
-    "BOOK", "CSV_COLUMNS", "GROUPS", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RULES",
-    "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS", "Note", "Row",
-    "Status", "book_link", "counts", "group_html", "half_unit", "in_seed_range", "in_widened_interval",
-    "intervals_overlap", "order_of_magnitude", "read_csv", "read_scorecard_json", "scorecard", "summary_html",
-    "within_points", "within_rounding", "write_scorecard",
+    "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "GROUPS", "JUDGED_ON", "NEEDED", "NOTES", "PRINTED",
+    "RANGE_VARIANTS", "RATIO_POINTS", "RULES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
+    "THETA0_VARIANTS", "Note", "Row", "Status", "book_link", "counts", "group_html", "half_unit", "in_seed_range",
+    "in_widened_interval", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
+    "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",
 ]

@@ -10,7 +10,7 @@ import sympy as sp
 
 from safepg import theory
 from safepg.envs.lqg import LQG
-from safepg.thesis import errata
+from safepg.thesis import authors, errata
 from safepg.thesis.experiments import LQG2D_GAMMA
 from safepg.thesis.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
 from safepg.thesis.scorecard.builder import Builder
@@ -142,10 +142,16 @@ def _lqg_rows(b: Builder) -> None:
           explanation=fill(NOTES["section-5.2/theta-star"].text, b.values))
     j2 = b.values["J_used"]
     j_text = repr(PRINTED_J_STAR)
+    # Their code's J (lqgnd/lqgnd.py@92ac378:226-227) at our theta*: 16 times the expectation.
+    theirs = authors.lqg2d_performance(K, 1.0, LQG2D_GAMMA)
     b.add(id="section-5.2/J-star", group="Section 5.2", quantity="J(θ*) (2-D LQG)", where="Section 5.2.1",
           thesis=f"≈ {j_text}", ours=f"{j2:.3f}", difference=signed(j2 - PRINTED_J_STAR, 3),
           ok=within_rounding(j2, j_text), rule="rounded", page="lqg2d", heading="setting as printed",
-          thesis_value=PRINTED_J_STAR, ours_value=j2)
+          thesis_value=PRINTED_J_STAR, ours_value=j2, authors=f"{theirs:.5f}", authors_value=theirs,
+          authors_experiment="safepg.thesis.authors.lqg2d_performance", authors_ok=within_rounding(theirs, j_text),
+          authors_note=f"Reproduced by the authors' own J (lqgnd/lqgnd.py@92ac378:226-227), which is 16 times the "
+                       f"expectation (the integral of s0'P s0 + W over the initial-state box [-2, 2]², not its "
+                       f"mean) at γ = 0.9: {theirs:.5f} at θ* = diag({t11:.6f}), where the consistent J is {j2:.4f}.")
 
 
 def closed_form_rows(b: Builder) -> None:

@@ -23,8 +23,10 @@ def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
 
 
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
-CSV_COLUMNS = ("id", "group", "quantity", "where", "thesis", "ours", "difference", "status", "rule", "explanation",
-               "link", "thesis_value", "ours_value", "ours_ci95_low", "ours_ci95_high", "seeds")
+CSV_COLUMNS = ("id", "group", "quantity", "where", "thesis", "ours", "difference", "status", "judged_on", "rule",
+               "explanation", "link", "thesis_value", "ours_value", "ours_ci95_low", "ours_ci95_high", "seeds",
+               "authors", "authors_value", "authors_ci95_low", "authors_ci95_high", "authors_seeds",
+               "authors_experiment", "authors_output", "authors_output_value", "authors_output_source", "slip")
 
 #: The thesis's tables: file stem -> row-id prefix.
 TABLES = {"table-5.1": "table-5.1/", "table-5.2": "table-5.2/", "table-5.3": "table-5.3/", "table-5.4": "table-5.4/"}
@@ -33,7 +35,8 @@ TABLES = {"table-5.1": "table-5.1/", "table-5.2": "table-5.2/", "table-5.3": "ta
 def _flat(r: Row) -> dict[str, Any]:
     d = {k: getattr(r, k) for k in CSV_COLUMNS if hasattr(r, k)}
     lo, hi = (r.ours_ci95 or [None, None])
-    d.update(ours_ci95_low=lo, ours_ci95_high=hi)
+    a_lo, a_hi = (r.authors_ci95 or [None, None])
+    d.update(ours_ci95_low=lo, ours_ci95_high=hi, authors_ci95_low=a_lo, authors_ci95_high=a_hi)
     return d
 
 
@@ -47,7 +50,8 @@ def _write_csv(path: Path, rows: Sequence[dict[str, Any]], columns: Sequence[str
 
 
 def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **kwargs: Any) -> dict[str, Path]:
-    """Write the scorecard and each thesis table (ours beside the thesis's) as CSV and JSON.
+    """Write the scorecard and each thesis table (ours, ours under the authors' settings and the
+    authors' output beside the thesis's) as CSV and JSON.
 
     Parameters
     ----------
@@ -79,7 +83,9 @@ def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **k
         keys = list(dict.fromkeys(k for r in sel for k in r.fields))
         flat = [{**r.fields, **_flat(r)} for r in sel]
         cols = [*keys, "quantity", "thesis", "ours", "ours_ci95_low", "ours_ci95_high", "difference", "status",
-                "thesis_value", "ours_value", "seeds", "id", "link"]
+                "judged_on", "thesis_value", "ours_value", "seeds", "authors", "authors_value", "authors_ci95_low",
+                "authors_ci95_high", "authors_seeds", "authors_experiment", "authors_output", "authors_output_value",
+                "authors_output_source", "slip", "id", "link"]
         p = out_dir / f"{stem}.csv"
         _write_csv(p, flat, cols)
         written[p.name] = p

@@ -9,9 +9,10 @@ from collections.abc import Sequence
 from functools import cache
 from importlib import resources
 
+from safepg.thesis.authors import REPOSITORY
 from safepg.thesis.scorecard.export import counts
 from safepg.thesis.scorecard.links import heading_id
-from safepg.thesis.scorecard.rules import STATUSES, Row
+from safepg.thesis.scorecard.rules import AUTHORS_STATUS, STATUSES, Row
 
 
 # The tables scroll inside their own box (never the page) with "scroll shadows": a shadow
@@ -26,7 +27,8 @@ def _style_sheet() -> str:
     return f"\n<style>\n{css}</style>\n"
 
 
-_STATUS_CLASS = {"reproduced": "sc-reproduced", "differs (explained)": "sc-explained", "open": "sc-open"}
+_STATUS_CLASS = {"reproduced": "sc-reproduced", AUTHORS_STATUS: "sc-authors", "differs (explained)": "sc-explained",
+                 "open": "sc-open"}
 _HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
          "columns).</p>")
 
@@ -75,26 +77,57 @@ def _cell(text: str, tex: str) -> str:
     return f'<td class="{"sc-num" if len(text) <= 32 else "sc-words"}">{_split(text)}</td>'
 
 
+def _source_link(source: str) -> str:
+    """The authors' file(s) a cell comes from, as a short link to their repository at that commit
+    (the whole ``path@commit`` is its title and is in the CSV/JSON)."""
+    m = re.fullmatch(r"(.+)@([0-9a-f]{7,40})", source)
+    if m is None:  # a file not in their repository
+        return f'<span class="sc-src">{html.escape(source)}</span>'
+    path, commit = m.groups()
+    runs = re.search(r"\{1-(\d+)\}", path)
+    if runs:  # several runs: their folder
+        url, label = f"{REPOSITORY}/tree/{commit}/{path.rsplit('/', 1)[0]}", f"{runs.group(1)} files @{commit[:7]}"
+    else:
+        url, label = f"{REPOSITORY}/blob/{commit}/{path}", f"file @{commit[:7]}"
+    return f'<a class="sc-src" href="{html.escape(url)}" title="{html.escape(source)}">{label}</a>'
+
+
+def _authors_cells(r: Row) -> str:
+    judged = " sc-judged" if r.judged_on == "authors' settings" else ""
+    ours = f'<td class="sc-num{judged}">{_split(r.authors or "")}</td>'
+    slip = '<span class="sc-slip">slip</span>' if r.slip else ""
+    src = f'<span class="sc-detail">{_source_link(r.authors_output_source)}</span>' if r.authors_output_source else ""
+    return f'{ours}<td class="sc-num sc-output">{html.escape(r.authors_output)}{slip}{src}</td>'
+
+
 def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
     """The rows of one group as an HTML table that scrolls inside its own box.
 
-    Each row carries ``data-id``, ``data-status``, ``data-thesis`` and ``data-ours`` (the plain
-    texts, also for closed forms shown as typeset math); its explanation, if any, is the
-    line below it.
+    Each row carries ``data-id``, ``data-status``, ``data-judged-on``, ``data-thesis``, ``data-ours``
+    and ``data-authors`` (the plain texts, also for closed forms shown as typeset math); its
+    explanation, if any, is the line below it. A group with rows run under the authors'
+    settings or with the authors' outputs has those two columns too; the cell a status was
+    judged on is marked.
     """
     sel = [r for r in rows if r.group == group]
     n = counts(sel).get(group, dict.fromkeys(STATUSES, 0))
-    line = ", ".join(f"{n[s]} {s}" for s in STATUSES)
-    cols = ("result", "status", "thesis", "ours", "ours − thesis", "discussed in")
+    line = ", ".join(f"{n[s]} {s}" for s in STATUSES if n[s])
+    wide = any(r.authors or r.authors_output for r in sel)
+    cols = ("result", "status", "thesis", "ours", "ours − thesis", *(("ours, authors' settings", "authors' output")
+                                                                      if wide else ()), "discussed in")
     head = "<tr>" + "".join(f"<th>{c}</th>" for c in cols) + "</tr>"
     body = []
     for r in sel:
+        ours = _cell(r.ours, r.ours_tex)
+        if r.judged_on == "ours" and r.status in ("reproduced", AUTHORS_STATUS) and not r.ours_tex:
+            ours = ours.replace('<td class="', '<td class="sc-judged ', 1)
         body.append(
             f'<tr class="sc-row" data-id="{html.escape(r.id)}" data-status="{html.escape(r.status)}" '
-            f'data-thesis="{html.escape(r.thesis)}" data-ours="{html.escape(r.ours)}">'
+            f'data-judged-on="{html.escape(r.judged_on)}" data-thesis="{html.escape(r.thesis)}" '
+            f'data-ours="{html.escape(r.ours)}" data-authors="{html.escape(r.authors)}">'
             f'<td class="sc-result">{html.escape(r.quantity)}<span class="sc-detail">{html.escape(r.where)}</span></td>'
-            f"<td>{_status_html(r.status)}</td>{_cell(r.thesis, r.thesis_tex)}{_cell(r.ours, r.ours_tex)}"
-            f'<td class="sc-num">{html.escape(r.difference)}</td>'
+            f"<td>{_status_html(r.status)}</td>{_cell(r.thesis, r.thesis_tex)}{ours}"
+            f'<td class="sc-num">{html.escape(r.difference)}</td>{_authors_cells(r) if wide else ""}'
             f'<td><a class="sc-link" href="{html.escape(r.link)}">{html.escape(_link_label(r.link))}</a></td></tr>')
         if r.explanation:
             body.append(f'<tr class="sc-note" data-for="{html.escape(r.id)}"><td colspan="{len(cols)}">'

@@ -1,15 +1,20 @@
 """Rows of the stored runs of Chapter 5: Tables 5.1-5.4, Figures 5.5-5.7, the step sizes and the
-cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.experiments.report`)."""
+cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.experiments.report`).
+
+Each row holds ours (the thesis's text), ours under the authors' settings where a variant runs
+them (the ``*-authors`` experiments; for Table 5.2's theoretical range, the authors' formula) and
+the authors' own output (:mod:`safepg.thesis.scorecard.outputs`)."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from safepg.learning import LearningRecord
-from safepg.thesis.experiments import T51_PRINTED_THETA0, Experiment
+from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
+from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import Builder
 from safepg.thesis.scorecard.rules import (
     PRINTED,
@@ -17,6 +22,7 @@ from safepg.thesis.scorecard.rules import (
     in_seed_range,
     in_widened_interval,
     intervals_overlap,
+    is_slip,
     order_of_magnitude,
     within_points,
 )
@@ -30,82 +36,119 @@ def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
     return float(m), [float(ci[0]), float(ci[1])]
 
 
-def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], variant: Experiment | None,
-                    variant_rep: Mapping[str, Any] | None) -> None:
-    """Table 5.1, cell by cell. ``variant``: the table from the other starting point (the printed
-    theta_0 when the table runs from a reconstructed one), quoted beside each cell."""
-    others = {}
-    for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
-        others[(vc.sigma, vc.batch_size, vc.alpha)] = (vc, vr)
-    printed_theta0 = repr(T51_PRINTED_THETA0)
-    for c, r in zip(exp.configs, rep["configs"]):
+def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[float] | None, text: str,
+             check: Callable[[float, list[float] | None], bool]) -> dict[str, Any]:
+    """The ``Builder.add`` arguments of ours under the authors' settings: the cell, and the row's
+    rule ``check(mean, ci)`` applied to it when every seed of ``exp`` is stored."""
+    if exp is None:
+        return {}
+    cells: dict[str, Any] = {"authors_experiment": exp.name, "authors_seeds": seeds}
+    if mean is None or seeds == 0:
+        return {**cells, "authors": "-"}
+    cells.update(authors_value=mean, authors_ci95=ci)
+    if seeds < exp.seeds:  # a partly computed campaign is shown, not judged
+        return {**cells, "authors": f"{text} ({seeds} of {exp.seeds} seeds: not judged)"}
+    return {**cells, "authors": text, "authors_ok": check(mean, ci)}
+
+
+def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
+    """The sentence naming a slip between the authors' output and the print ("" when none).
+    ``printed`` as printed (a percentage for a ratio: ``scale`` 100 brings the output there)."""
+    if out.value is None or not out.complete or not is_slip(scale * out.value, printed):
+        return ""
+    return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
+            f"({out.source}), the thesis prints {show(float(printed))}.")
+
+
+def _said(cells: Mapping[str, Any]) -> str:
+    """Ours under the authors' settings as a note quotes it."""
+    text = cells.get("authors", "-")
+    return "(not stored yet)" if text == "-" else text
+
+
+def _report_row(rep: Mapping[str, Any] | None, name: str) -> Mapping[str, Any] | None:
+    for r in (rep or {}).get("configs", []):
+        if r["name"] == name:
+            return r
+    return None
+
+
+def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed: Experiment,
+                    printed_rep: Mapping[str, Any], authors: Experiment | None,
+                    authors_rep: Mapping[str, Any] | None) -> None:
+    """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the
+    authors' settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed
+    theta_0, found before their outputs were read) is quoted in the explanation."""
+    recon = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(exp.configs, rep["configs"])}
+    theirs = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(authors.configs if authors else (),
+                                                                   (authors_rep or {}).get("configs", []))}
+    b.values.update(t51_theta0=f"{T51_PRINTED_THETA0:g}", t51_authors_theta0=f"{AUTHORS_T51_THETA0:g}")
+    for c, r in zip(printed.configs, printed_rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
         if thesis is None:
             continue
+        key = (c.sigma, c.batch_size, c.alpha)
         mean, ci = _mean_ci(r["improvement_ratio"])
         ok = None if mean is None else within_points(mean, thesis)
-        rid = f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"
-        explanation = None
-        theta0 = c.theta0[0]
-        vc, vr = others.get((c.sigma, c.batch_size, c.alpha), (None, None))
-        v_mean = None if vr is None else vr["improvement_ratio"]["mean"]
-        if ok and theta0 != float(printed_theta0):
-            explanation = f"Run from θ0 = {theta0:g}, our reconstruction: the thesis prints θ0 = {printed_theta0}" + \
-                (f", from which ours is {pct(v_mean)}." if v_mean is not None and vc.theta0[0] == float(printed_theta0)
-                 else ".")
-        b.values["t51_theta0"] = f"{theta0:g}"
-        b.add(id=rid, group="Section 5.1", quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, "
-              f"α = {c.alpha:.0e}", where="Table 5.1", thesis=pct(thesis),
-              ours=pct(mean) + ci_text(ci, lambda x: pct(x, 1)),
+        ar = theirs.get(key)
+        a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
+        a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                           pct(a_mean) + ci_text(a_ci, lambda x: pct(x, 1)),
+                           lambda m, _, t=thesis: within_points(m, t))
+        rc = recon.get(key)
+        rc_mean = None if rc is None else rc["improvement_ratio"]["mean"]
+        recon_text = "" if rc_mean is None else \
+            (f" Our reconstruction θ0 = {exp.configs[0].theta0[0]:g}, found before their outputs were read, "
+             f"gives {pct(rc_mean)}.")
+        out = outputs.table_5_1(*key)
+        printed_text = f"{100 * thesis:.6g}"
+        b.add(id=f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}", group="Section 5.1",
+              quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, α = {c.alpha:.0e}", where="Table 5.1",
+              thesis=pct(thesis), ours=pct(mean) + ci_text(ci, lambda x: pct(x, 1)),
               difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
-              rule="ratio-points", page="lqg1d", heading="Table 5.1", explanation=explanation, thesis_value=thesis,
-              ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=exp.seeds,
-              fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": theta0})
-
-
-def _range_label(r: Mapping[str, Any] | None, cfg: Any) -> str:
-    rng = getattr(cfg, "theoretical_range", None)
-    return f"the range {rng:g} (our reconstruction, not printed)" if rng is not None else "Lemma 4.3.3's range"
+              rule="ratio-points", page="lqg1d", heading="Table 5.1", thesis_value=thesis, ours_value=mean,
+              ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds,
+              authors_note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} ours is more than 5 points off; from the "
+                           f"authors' θ0 = {AUTHORS_T51_THETA0:g} (where all 24 of their output files start), counted "
+                           "as they counted (strict increases over 10^6/N - 1 updates), it is within 5." + recon_text,
+              slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
+              fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": c.theta0[0]},
+              **a_cells, **out.cells())
 
 
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                     variant: Experiment | None, variant_rep: Mapping[str, Any] | None) -> None:
+    """Table 5.2 row by row. The two theoretical-range rows (Hoeffding and Bernstein without the
+    empirical range) are judged on Lemma 4.3.3's range as printed (``variant``), then on the
+    authors' formula, 2 M_phi A_bar abs(A) R / (sigma^2 (1 - gamma)) = 1280, which ``exp`` runs."""
     dec = TABLE_DECIMALS["table-5.2"]
     fmt = lambda x: num(x, dec)  # noqa: E731
-    # The variant reruns the theoretical-range rows with the other range (Lemma 4.3.3's or
-    # the reconstructed one): matched to the table's rows by estimator, bound and delta.
-    variants = {}
+    lemma = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
-        variants[(vc.estimator, vc.bound, vc.empirical_range, vc.delta)] = (vc, vr)
+        if vc.theoretical_range is None:
+            lemma[(vc.estimator, vc.bound, vc.empirical_range, vc.delta)] = (vc, vr)
     ratios = []
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
         if "upsilon_bar" not in th:
             continue
+        key = (c.estimator, c.bound, c.empirical_range, c.delta)
         mean, ci = _mean_ci(r["upsilon_bar"])
-        ok = None if mean is None else intervals_overlap(ci, th["ci95"])
         ratios.append(r["improvement_ratio"]["mean"])
-        theoretical = c.bound != "chebyshev" and not c.empirical_range
-        note_id, explanation = None, None
+        out = outputs.table_5_2(key)
+        seeds, a_cells, note_id = r["seeds"], {}, None
+        theoretical = c.bound != "chebyshev" and not c.empirical_range and key in lemma
         if theoretical:
-            vc, vr = variants.get((c.estimator, c.bound, c.empirical_range, c.delta), (None, None))
-            v_text, v_ok = "not computed", None
-            if vr is not None and vr["upsilon_bar"]["mean"] is not None:
-                vm, vci = _mean_ci(vr["upsilon_bar"])
-                v_ok = intervals_overlap(vci, th["ci95"])
-                v_text = f"{fmt(vm)}{ci_text(vci, fmt)}"
-            if ok:
-                explanation = f"Reproduced with {_range_label(r, c)}; with {_range_label(vr, vc)} " \
-                              f"ours is {v_text}." if vc is not None else f"Reproduced with {_range_label(r, c)}."
-            elif ok is not None and c.theoretical_range is not None:
-                # The row runs with a reconstructed range: the gap is the unknown constant's.
-                b.values["range_gap"] = (f"with our reconstruction {c.theoretical_range:g} ours is "
-                                         f"{100 * abs(mean - th['upsilon_bar']) / abs(th['upsilon_bar']):.2f}% "
-                                         f"from the printed value; with {_range_label(vr, vc)} it is {v_text}")
-                note_id = "table-5.2/reconstructed-range"
-            else:
-                b.values["variant"] = f"{v_text} with {_range_label(vr, vc)}"
-                note_id = "table-5.2/theoretical-range" if v_ok else "table-5.2/theoretical-range-unexplained"
+            vc, vr = lemma[key]
+            a_cells = _authors(exp, seeds, mean, ci, f"{fmt(mean)}{ci_text(ci, fmt)}",
+                               lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t))  # type: ignore[arg-type]
+            mean, ci = _mean_ci(vr["upsilon_bar"])
+            seeds = vr["seeds"]
+            b.values["range_rows"] = (f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
+                                      f"authors' 1280 {a_cells.get('authors', '-')} over "
+                                      f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
+            note_id = "table-5.2/theoretical-range"
+        ok = None if mean is None else intervals_overlap(ci, th["ci95"])
         er = " (e.r.)" if c.empirical_range else ""
         label = f"{c.estimator}-{c.bound}{'-er' if c.empirical_range else ''}-delta={c.delta:g}"
         b.add(id=f"table-5.2/{label}", group="Section 5.1",
@@ -113,12 +156,15 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
               f"{c.bound.capitalize()}{er}, δ = {c.delta:g}", where="Table 5.2",
               thesis=f"{fmt(th['upsilon_bar'])}{ci_text(th['ci95'], fmt)}", ours=f"{fmt(mean)}{ci_text(ci, fmt)}",
               difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
-              page="lqg1d", heading="Table 5.2", note_id=note_id, explanation=explanation,
-              thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-              expected_seeds=exp.seeds,
+              page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"], ours_value=mean,
+              ours_ci95=ci, seeds=seeds, expected_seeds=exp.seeds,
+              authors_note="Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the "
+                           "authors' formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) = 1280 "
+                           "(lqg/lqg_adabatch.py@af36577:50-52), reproduces it.",
+              slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
               fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
-                      "delta": c.delta, "theoretical_range": c.theoretical_range,
-                      "thesis_ci95": list(th["ci95"])})
+                      "delta": c.delta, "theoretical_range": None if theoretical else c.theoretical_range,
+                      "thesis_ci95": list(th["ci95"])}, **a_cells, **out.cells())
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
     complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
     got = [x for x in ratios if x is not None] if complete else []
@@ -131,16 +177,26 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
           page="lqg1d", heading="Table 5.2", thesis_value=1.0, ours_value=low)
 
 
-def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, recs: Mapping[str, Sequence],
-               names: Iterable[str], k: int, page: str, heading: str, seeds: int) -> None:
-    medians, names = [], list(names)
+def _median_steps(recs: Mapping[str, Sequence], names: list[str], seeds: int) -> list[float] | None:
+    """Median positive step of each configuration, or None unless every seed of each is stored."""
     if any(len(recs.get(n, [])) < seeds for n in names):  # judged on the whole campaign only
-        names = names + ["(missing seeds)"]
+        return None
+    medians = []
     for n in names:
         steps = np.concatenate([r.alpha[r.alpha > 0] for r in recs.get(n, [])] or [np.empty(0)])
-        if steps.size:
-            medians.append(float(np.median(steps)))
-    if medians and len(medians) == len(names):  # "in all the experiments": every configuration run
+        if not steps.size:
+            return None
+        medians.append(float(np.median(steps)))
+    return medians
+
+
+def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, recs: Mapping[str, Sequence],
+               names: Iterable[str], k: int, page: str, heading: str, seeds: int, authors: Experiment | None = None,
+               authors_recs: Mapping[str, Sequence] | None = None, output: outputs.Output | None = None,
+               authors_note: str = "") -> None:
+    names = list(names)
+    medians = _median_steps(recs, names, seeds)
+    if medians:  # "in all the experiments": every configuration run
         ours = f"median {np.median(medians):.1e}" + \
                (f" (per configuration {min(medians):.1e} to {max(medians):.1e})" if len(medians) > 1 else "")
         ok = all(order_of_magnitude(m) == k for m in medians)
@@ -148,8 +204,18 @@ def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, r
         diff = f"order 10^{order_of_magnitude(value)}"
     else:
         ours, ok, value, diff = "-", None, None, "-"
+    a_cells: dict[str, Any] = {}
+    if authors is not None:
+        a_names = [c.name for c in authors.configs]
+        got = dict(authors_recs or {})
+        a_med = _median_steps(got, a_names, 1)
+        n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
+        a_cells = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
+                           f"median {np.median(a_med):.1e}" if a_med else "-",
+                           lambda *_: all(order_of_magnitude(m) == k for m in a_med))  # type: ignore[union-attr]
     b.add(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{k}", ours=ours,
-          difference=diff, ok=ok, rule="order", page=page, heading=heading, thesis_value=10.0**k, ours_value=value)
+          difference=diff, ok=ok, rule="order", page=page, heading=heading, thesis_value=10.0**k, ours_value=value,
+          authors_note=authors_note, **a_cells, **(output.cells() if output else {}))
 
 
 def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
@@ -159,7 +225,8 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         label = {"scalar": "scalar step of [24]", "coordinate": "coordinate step Λ*"}.get(c.name, c.name)
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
-            b.add(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2",
+            out = outputs.lqg2d(c.name, "improvement_ratio")
+            b.add(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", **out.cells(),
                   quantity=f"improvement ratio, {label}, N = {c.batch_size}", where="Section 5.2.1 (Figure 5.5)",
                   thesis=pct(th["improvement_ratio"]), ours=pct(mean),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
@@ -175,7 +242,12 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                 seeds = finals[:, i, j] if finals.size else np.empty(0)
                 mean = float(seeds.mean()) if seeds.size else None
                 rid = f"section-5.2/theta-final-{c.name}/{i + 1}{j + 1}"
-                b.add(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}",
+                out = outputs.lqg2d(c.name, "theta_final", (i, j))
+                b.values[f"authors_theta_{c.name}_{i + 1}{j + 1}"] = out.text
+                if seeds.size:
+                    b.values[f"seeds_theta_{c.name}_{i + 1}{j + 1}"] = f"{seeds.min():.6g} to {seeds.max():.6g}"
+                b.add(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}", **out.cells(),
+                      slip_note=_slip(out, text, lambda v: f"{v:.6g}"),
                       where="Section 5.2.1 (after Figure 5.5)", thesis=text,
                       ours="-" if mean is None else
                       f"{mean:.6g} (seeds {seeds.min():.6g} to {seeds.max():.6g})",
@@ -187,66 +259,153 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
 
 
 def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[str, Any], page: str,
-                        heading: str, group: str) -> None:
+                        heading: str, group: str, authors: Experiment | None = None,
+                        authors_rep: Mapping[str, Any] | None = None,
+                        output: Callable[[str, str], outputs.Output] | None = None, authors_note: str = "",
+                        also: tuple[Experiment, Mapping[str, Any]] | None = None) -> None:
+    """Average performance and improvement ratio of each method of Table 5.3 or 5.4: ours, ours under
+    the authors' settings (``authors``, matched by config name) and ``output(config, quantity)``;
+    ``also``: another run of the authors' settings, quoted in the row's explanation."""
     dec = TABLE_DECIMALS[table]
     fmt = lambda x: num(x, dec)  # noqa: E731
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
         method = "adaptive N" if c.batch_size is None else f"N = {c.batch_size}"
+        ar = _report_row(authors_rep, c.name)
+        other = _report_row(also[1], c.name) if also else None
         if "upsilon_bar" in th:
             text = fmt(th["upsilon_bar"])
             mean, ci = _mean_ci(r["upsilon_bar"])
+            a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
+            a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
+                               lambda _, c95, t=text: in_widened_interval(t, c95))  # type: ignore[arg-type]
+            out = output(c.name, "upsilon_bar") if output else None
             b.add(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(ci, fmt)}",
                   difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec),
                   ok=None if mean is None else in_widened_interval(text, ci), rule="ci-contains", page=page,
                   heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-                  expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"})
+                  expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
+                  authors_note=authors_note, slip_note="" if out is None else _slip(out, text, fmt),
+                  remark=_missing(out) or _also(also, other, "upsilon_bar", fmt),
+                  **a_cells, **(out.cells() if out else {}))
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
+            thesis = th["improvement_ratio"]
+            a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
+            a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                               pct(a_mean) + ci_text(a_ci, lambda x: pct(x, 1)),
+                               lambda m, _, t=thesis: within_points(m, t))
+            out = output(c.name, "improvement_ratio") if output else None
             b.add(id=f"{table}/{c.name}/improvement-ratio", group=group, quantity=f"improvement ratio, {method}",
-                  where=table.replace("table-", "Table "), thesis=pct(th["improvement_ratio"]),
+                  where=table.replace("table-", "Table "), thesis=pct(thesis),
                   ours=pct(mean) + ci_text(ci, lambda x: pct(x, 1)),
-                  difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
-                  ok=None if mean is None else within_points(mean, th["improvement_ratio"]), rule="ratio-points",
-                  page=page, heading=heading, thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci,
+                  difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
+                  ok=None if mean is None else within_points(mean, thesis), rule="ratio-points",
+                  page=page, heading=heading, thesis_value=thesis, ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds,
-                  fields={"method": c.name, "quantity": "improvement_ratio"})
+                  fields={"method": c.name, "quantity": "improvement_ratio"}, authors_note=authors_note,
+                  slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
+                  remark=_missing(out) or _also(also, other, "improvement_ratio", pct),
+                  **a_cells, **(out.cells() if out else {}))
 
 
-def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord]], seeds: int) -> None:
-    adaptive = recs.get("adaptive", [])
-    # As the chapter measures them: mean batch over iterations 2-11, and over the last 10 full ones.
-    first = [float(r.batch_size[1:11].mean()) for r in adaptive if r.iterations > 11]
-    last = [float(r.batch_size[-11:-1].mean()) for r in adaptive if r.iterations > 11]
+def _also(also: tuple[Experiment, Mapping[str, Any]] | None, row: Mapping[str, Any] | None, key: str,
+          fmt: Callable[[float], str]) -> str:
+    """The sentence quoting another run of the authors' settings (``also``) for this row."""
+    if also is None:
+        return ""
+    exp = also[0]
+    what = f"Under the authors' settings from their own baseline policy, theta_star.npy@a82576f ({exp.name})"
+    if row is None or not row["seeds"] or row[key]["mean"] is None:
+        return f"{what}: not stored yet."
+    m, ci = _mean_ci(row[key])
+    return f"{what}: {fmt(m)}{ci_text(ci, fmt)} ({row['seeds']} of {exp.seeds} seeds, one start for all)."
+
+
+def _missing(out: outputs.Output | None) -> str:
+    if out is None or out.value is not None:
+        return ""
+    return (f"The authors' output for this run is not in their repository ({out.source} is absent), so the "
+            "printed value cannot be checked against it.")
+
+
+def _t53_output(name: str, quantity: str) -> outputs.Output:
+    return outputs.lqg2d_missing() if name == "N=100" else outputs.lqg2d(name, quantity)
+
+
+def _t54_output(name: str, quantity: str) -> outputs.Output:
+    return outputs.cartpole("adaptive" if name == "adaptive" else "fixed", quantity)
+
+
+def _batch_means(recs: Sequence[LearningRecord]) -> tuple[list[float], list[float]]:
+    """Mean batch over iterations 2-11 and over the last 10 full ones, per run (as the chapter measures them)."""
+    first = [float(r.batch_size[1:11].mean()) for r in recs if r.iterations > 11]
+    last = [float(r.batch_size[-11:-1].mean()) for r in recs if r.iterations > 11]
+    return first, last
+
+
+def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord]], seeds: int,
+                          authors: Experiment | None, authors_recs: Mapping[str, Sequence[LearningRecord]]) -> None:
+    first, last = _batch_means(recs.get("adaptive", []))
+    a_first, a_last = _batch_means(authors_recs.get("adaptive", []))
     b.values.update(batch_first=float(np.mean(first)) if first else float("nan"),
                     batch_last=float(np.mean(last)) if last else float("nan"))
-    for rid, q, key, vals in (("section-5.2/batch-first", "adaptive batch size, first iterations (2-11)",
-                               "lqg2d_batch_first", first),
-                              ("section-5.2/batch-last", "adaptive batch size, last 10 iterations",
-                               "lqg2d_batch_last", last)):
+    note = ("Reproduced with the authors' adaptive run: Bernstein on the largest variance and range over the "
+            "components and N_max = 100000 (lqgnd/lqgnd_adabatch.py@92ac378:256-257), the step taken even when "
+            "ε ≥ abs(g_k).")
+    for rid, q, key, vals, a_vals in (("section-5.2/batch-first", "adaptive batch size, first iterations (2-11)",
+                                       "lqg2d_batch_first", first, a_first),
+                                      ("section-5.2/batch-last", "adaptive batch size, last 10 iterations",
+                                       "lqg2d_batch_last", last, a_last)):
         printed = PRINTED[key]
         mean = float(np.mean(vals)) if vals else None
+        out = outputs.lqg2d("adaptive", key.replace("lqg2d_", ""))
+        b.values[f"authors_{key}"] = out.text
+        a_mean = float(np.mean(a_vals)) if a_vals else None
+        a_cells = _authors(authors, len(a_vals), a_mean, None,
+                           "-" if a_mean is None else f"{a_mean:.0f} (seeds {min(a_vals):.0f} to {max(a_vals):.0f})",
+                           lambda *_, v=a_vals, t=printed: in_seed_range(v, t))
+        b.values[f"authors_settings_{key}"] = _said(a_cells)
         b.add(id=rid, group="Section 5.2", quantity=q, where="Section 5.2.1 (Figure 5.7)", thesis=f"≈ {printed}",
               ours="-" if mean is None else f"{mean:.0f} (seeds {min(vals):.0f} to {max(vals):.0f})",
               difference="-" if mean is None else f"{mean - float(printed):+.0f}",
               ok=None if mean is None else in_seed_range(vals, printed), rule="seed-range", page="lqg2d",
               heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
-              expected_seeds=seeds)
+              expected_seeds=seeds, authors_note=note, slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"),
+              **a_cells, **out.cells())
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
-               k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds)
+               k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
+               authors_recs=authors_recs, output=outputs.lqg2d("adaptive", "step"), authors_note=note)
 
 
-def _cartpole_rows(b: Builder, base_exp: Experiment, base_recs: Mapping[str, Sequence[LearningRecord]],
-                   exp54: Experiment, rep54: Mapping[str, Any], recs54: Mapping[str, Sequence[LearningRecord]]) -> None:
+#: Table 5.4 under the authors' settings: the variant judged, their whole protocol (each seed runs
+#: their baseline search, then adapts; the printed values are one run of it, so our interval must
+#: hold the spread of the starting policies too), and the one from their own baseline policy
+#: (theta_star.npy: one start for every seed), quoted beside it.
+T54_AUTHORS, T54_AUTHORS_THETA_STAR = "table-5.4-authors", "table-5.4-authors-theta-star"
+_STATE = ("x", "dx/dt", "β", "dβ/dt")  # the cart-pole's state [x, x_dot, beta, beta_dot]
+
+
+def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapping[str, Any]],
+                   recs: Mapping[str, Mapping[str, Sequence[LearningRecord]]]) -> None:
+    base_exp, base_recs = exps["cartpole-baseline"], recs["cartpole-baseline"]
+    exp54, rep54, recs54 = exps["table-5.4"], reps["table-5.4"], recs["table-5.4"]
+    a_base = exps.get("cartpole-baseline-authors")
     for c in base_exp.configs:
         th = base_exp.thesis.get(c.name, {})
         if "iterations" not in th:
             continue
         its = [float(r.iterations) for r in base_recs.get(c.name, [])]
+        a_its = [float(r.iterations) for r in recs.get("cartpole-baseline-authors", {}).get(c.name, [])]
         text = str(th["iterations"])
         mean = float(np.mean(its)) if its else None
+        a_mean = float(np.mean(a_its)) if a_its else None
+        a_cells = _authors(a_base, len(a_its), a_mean, None,
+                           "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
+                           lambda *_, v=a_its, t=text: in_seed_range(v, t))
+        b.values["authors_baseline"] = _said(a_cells)
         b.add(id="section-5.3/baseline-iterations", group="Section 5.3",
               quantity=f"iterations of the baseline (N = {c.batch_size}, α = {c.alpha:g}) to reach "
               f"{c.target_return:g}", where="Section 5.3", thesis=text,
@@ -254,11 +413,13 @@ def _cartpole_rows(b: Builder, base_exp: Experiment, base_recs: Mapping[str, Seq
               difference="-" if mean is None else f"{mean - th['iterations']:+.1f}",
               ok=None if mean is None else in_seed_range(its, text), rule="seed-range", page="cartpole",
               heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean, seeds=len(its),
-              expected_seeds=base_exp.seeds)
+              expected_seeds=base_exp.seeds, **a_cells, **outputs.cartpole("baseline", "iterations").cells(),
+              authors_note="Reproduced on the authors' task: gym's 12° termination (cartpole/cartpole.py@b9588b7:42; "
+                           "the thesis prints 41.8°), the undiscounted return (cartpole/polgrad.py@aadbf5b:178), and "
+                           "the update of the batch that reaches 195 kept.")
     adaptive = recs54.get("adaptive", [])
     steps = np.concatenate([r.alpha[r.alpha > 0] for r in adaptive] or [np.empty(0)])
     b.values["adaptive_steps"] = f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none"
-    names = ["x", "dx/dt", "β", "dβ/dt"]  # the state [x, x_dot, beta, beta_dot]
     never = PRINTED["cartpole_components_never_updated"]
     updated = None
     for r in rep54["configs"]:
@@ -266,23 +427,44 @@ def _cartpole_rows(b: Builder, base_exp: Experiment, base_recs: Mapping[str, Seq
             updated = r["components_updated"]
     if updated is not None:
         extra = [i for i in updated if i in never]
-        b.values["extra"] = ", ".join(names[i] for i in extra) or "nothing else"
+        b.values["extra"] = ", ".join(_STATE[i] for i in extra) or "nothing else"
         moves = [np.abs(r.theta_final - r.theta[0])[extra] for r in adaptive]
         b.values["extra_move"] = float(np.max(moves)) if extra and moves else 0.0
+    a54 = exps.get(T54_AUTHORS)
+    a_row = _report_row(reps.get(T54_AUTHORS), "adaptive")
+    a_updated = a_row["components_updated"] if a_row and a_row["seeds"] else None
+    a_cells = _authors(a54, a_row["seeds"] if a_row else 0, None if a_updated is None else 0.0, None,
+                       "-" if a_updated is None else ", ".join(_STATE[i] for i in range(4) if i not in a_updated),
+                       lambda *_: not set(a_updated or ()) & set(never))
+    theirs = outputs.cartpole_components_updated()
+    b.values["authors_components"] = _said(a_cells)
     b.add(id="section-5.3/components", group="Section 5.3",
           quantity="components of θ the adaptive method never updates", where="Section 5.3, after Table 5.4",
-          thesis=", ".join(names[i] for i in never),
-          ours="-" if updated is None else ", ".join(names[i] for i in range(4) if i not in updated) or "none",
+          thesis=", ".join(_STATE[i] for i in never),
+          ours="-" if updated is None else ", ".join(_STATE[i] for i in range(4) if i not in updated) or "none",
           difference="-" if updated is None else
           ("none" if not set(updated) & set(never) else "also updates " + b.values["extra"]),
           ok=None if updated is None else not set(updated) & set(never), rule="set", page="cartpole",
-          heading="Table 5.4")
-    _upsilon_table_rows(b, "table-5.4", exp54, rep54, "cartpole", "Table 5.4", "Section 5.3")
+          heading="Table 5.4", **{**a_cells, "authors_value": None},
+          authors_output=", ".join(_STATE[i] for i in range(4) if i not in theirs),
+          authors_output_source=outputs.cartpole("adaptive", "upsilon_bar").source,
+          authors_note="Reproduced with the authors' adaptive run (their doubled pole at 12°, undiscounted, "
+                       "γ = 0.9 and R, M_φ measured per batch in c, the maxima over components, unguarded "
+                       "steps): only x and dx/dt move, as in their own run.")
+    _upsilon_table_rows(b, "table-5.4", exp54, rep54, "cartpole", "Table 5.4", "Section 5.3", a54,
+                        reps.get(T54_AUTHORS), _t54_output,
+                        authors_note="Reproduced on the authors' task and methods, from our runs of their "
+                                     "baseline search: 12° termination, their doubled pole (m l kept at 0.05), "
+                                     "undiscounted return, γ = 0.9 and per-batch R, M_φ in c, first N = 1000, the "
+                                     "maxima over components, unguarded steps; their 'vanilla' moves only the "
+                                     "largest component; both averaged over 1151669 trajectories as "
+                                     "plot_cartpole.m@54d92b0 does.",
+                        also=(exps[T54_AUTHORS_THETA_STAR], reps[T54_AUTHORS_THETA_STAR])
+                        if T54_AUTHORS_THETA_STAR in exps else None)
 
 
 def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapping[str, Any]],
-             recs: Mapping[str, Mapping[str, Sequence[LearningRecord]]], range_variant: str | None,
-             theta0_variant: str | None) -> None:
+             recs: Mapping[str, Mapping[str, Sequence[LearningRecord]]], range_variant: str | None) -> None:
     """Add the rows of the Chapter 5 runs to ``b``, in the thesis's order.
 
     Parameters
@@ -290,14 +472,14 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
     b : Builder
         The rows so far.
     exps, reps, recs : mapping
-        By experiment name (:data:`~safepg.thesis.scorecard.rows.NEEDED` and the variants): the
-        experiment, its report, its records by configuration.
-    range_variant, theta0_variant : str or None
-        Names of the Table 5.2 variant with the other theoretical range and of the Table 5.1
-        variant from the other theta_0, when the library defines them.
+        By experiment name (:data:`~safepg.thesis.scorecard.rows.NEEDED`, the range variant and
+        the authors' variants that are defined): the experiment, its report, its records by
+        configuration.
+    range_variant : str or None
+        Name of the Table 5.2 variant with Lemma 4.3.3's range, when the library defines it.
     """
-    _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps.get(theta0_variant or ""),
-                    reps.get(theta0_variant or ""))
+    _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps["table-5.1-printed-theta0"],
+                    reps["table-5.1-printed-theta0"], exps.get("table-5.1-authors"), reps.get("table-5.1-authors"))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
                     reps.get(range_variant or ""))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
@@ -305,7 +487,12 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
                names=[c.name for c in exps["table-5.2"].configs], k=PRINTED["lqg1d_step_order"], page="lqg1d",
                heading="Figures 5.3 and 5.4", seeds=exps["table-5.2"].seeds)
     _figures_5_5_5_6_rows(b, exps["figures-5.5-5.6"], reps["figures-5.5-5.6"], recs["figures-5.5-5.6"])
-    _upsilon_table_rows(b, "table-5.3", exps["table-5.3"], reps["table-5.3"], "lqg2d", "Table 5.3", "Section 5.2")
-    _table_5_3_extra_rows(b, recs["table-5.3"], exps["table-5.3"].seeds)
-    _cartpole_rows(b, exps["cartpole-baseline"], recs["cartpole-baseline"], exps["table-5.4"], reps["table-5.4"],
-                   recs["table-5.4"])
+    _upsilon_table_rows(b, "table-5.3", exps["table-5.3"], reps["table-5.3"], "lqg2d", "Table 5.3", "Section 5.2",
+                        exps.get("table-5.3-authors"), reps.get("table-5.3-authors"), _t53_output,
+                        authors_note="Reproduced with the authors' adaptive run: Bernstein on the largest variance "
+                                     "and range over the components, N_max = 100000 (lqgnd/lqgnd_adabatch.py@92ac378:"
+                                     "256-257), the step taken even when ε ≥ abs(g_k), the ratio counting strict "
+                                     "increases.")
+    _table_5_3_extra_rows(b, recs["table-5.3"], exps["table-5.3"].seeds, exps.get("table-5.3-authors"),
+                          recs.get("table-5.3-authors", {}))
+    _cartpole_rows(b, exps, reps, recs)
