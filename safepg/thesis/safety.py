@@ -55,9 +55,10 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
         {"assumption": "eps from a range bound, not the batch's own range",
          "holds": not (cfg.bound in ("bernstein", "hoeffding") and cfg.empirical_range),
          "why": "theoretical range" if not cfg.empirical_range else "the empirical range of the batch"},
-        {"assumption": "every batch size chosen by the bound",
+        {"assumption": "batch sizes as Algorithm 4.1 sets them (N_min, then N* of the bound)",
          "holds": cfg.n_first is None,
-         "why": "the first batch is N_min" if cfg.n_first is None else f"the first batch is fixed at {cfg.n_first}"},
+         "why": "the first batch is the algorithm's N_min, every later one the bound's N*" if cfg.n_first is None
+         else f"the first batch is fixed at {cfg.n_first}, outside the algorithm"},
     ]
     return rows
 
