@@ -93,3 +93,10 @@ def test_spread_updates():
     assert safety.spread_updates(3, 10).tolist() == [0, 1, 2]
     with pytest.raises(ValueError, match="count"):
         safety.spread_updates(3, 0)
+
+
+def test_normal_quantile():
+    assert safety.normal_quantile("0.01") == pytest.approx(2.5758293035489004, abs=1e-15)
+    assert safety.normal_quantile("0.05") == pytest.approx(1.959963984540054, abs=1e-15)
+    with pytest.raises(ValueError, match="tails"):
+        safety.normal_quantile("1.5")

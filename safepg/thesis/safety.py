@@ -26,6 +26,7 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +36,6 @@ from safepg import portable
 from safepg.learning import LearningRecord
 from safepg.policies import LinearGaussianPolicy
 from safepg.runner import RESULTS_VERSION, RunConfig
-from safepg.stats import t_quantile
 
 
 def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
@@ -194,11 +194,28 @@ def paired_returns(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: fl
     return out[0], out[1]
 
 
+@cache
+def normal_quantile(tails: str) -> float:
+    """The standard normal quantile leaving ``tails`` (a decimal string) in the two tails together.
+
+    mpmath (software arithmetic), so the same on every CPU; for thousands of rollouts it is the
+    Student-t quantile to four digits (``safepg.stats.t_quantile``'s series does not converge
+    there for small tails).
+    """
+    import mpmath
+
+    with mpmath.workdps(40):
+        p = mpmath.mpf(tails)
+        if not 0 < p < 1:
+            raise ValueError(f"tails must be in (0, 1), got {tails!r}")
+        return float(mpmath.sqrt(2) * mpmath.erfinv(1 - p))
+
+
 def _interval(d: np.ndarray, tails: str) -> tuple[float, float, float]:
-    """Mean of the paired differences and its t-interval leaving ``tails`` outside (fsum: portable)."""
+    """Mean of the paired differences and its interval leaving ``tails`` outside (fsum: portable)."""
     m = portable.fsum_mean(d)
     s = math.sqrt(math.fsum(((d - m) * (d - m)).tolist()) / (d.size - 1))
-    h = t_quantile(d.size - 1, tails) * s / math.sqrt(d.size)
+    h = normal_quantile(tails) * s / math.sqrt(d.size)
     return m, m - h, m + h
 
 
@@ -210,10 +227,10 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
     (:func:`paired_returns`). At the first look every update gets ``looks[0]`` rollouts per
     policy; an update whose interval contains 0 gets fresh rollouts (new seeds) up to
     ``looks[1]``, and so on: the rollout count grows until the interval is narrower than the
-    change, or the last look is reached. Each look's interval is a Student-t interval at level
-    ``1 - alpha / len(looks)``, so that the interval at which an update stops covers its true change
-    with probability at least ``1 - alpha`` (Bonferroni over the looks; the t-interval is
-    asymptotic, with thousands of rollouts per look).
+    change, or the last look is reached. Each look's interval is the normal interval at level
+    ``1 - alpha / len(looks)`` (:func:`normal_quantile`), so that the interval at which an update
+    stops covers its true change with probability at least ``1 - alpha`` (Bonferroni over the looks;
+    asymptotically, with hundreds to thousands of rollouts per look).
 
     Parameters
     ----------
@@ -237,8 +254,8 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
     ks = np.arange(T.shape[0] - 1) if updates is None else np.asarray(updates, dtype=int)
     if ks.size and (ks.min() < 0 or ks.max() >= T.shape[0] - 1):
         raise ValueError(f"updates must lie in [0, {T.shape[0] - 2}], got {ks.min()}..{ks.max()}")
-    if not looks or any(b <= a for a, b in zip((1,) + tuple(looks), looks)):
-        raise ValueError(f"looks must be increasing counts > 1, got {looks}")
+    if not looks or looks[0] < 100 or any(b <= a for a, b in zip(looks, looks[1:])):
+        raise ValueError(f"looks must be increasing counts >= 100 (the interval is asymptotic), got {looks}")
     tails = repr(float(alpha) / len(looks))
     diffs: list[list[np.ndarray]] = [[] for _ in ks]
     result = np.zeros((ks.size, 3))
