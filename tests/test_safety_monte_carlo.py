@@ -100,3 +100,12 @@ def test_normal_quantile():
     assert safety.normal_quantile("0.05") == pytest.approx(1.959963984540054, abs=1e-15)
     with pytest.raises(ValueError, match="tails"):
         safety.normal_quantile("1.5")
+
+
+def test_measure_runs_joins_the_runs(tmp_path):
+    runs = [THETAS[:5], THETAS[4:]]
+    out = safety.measure_runs(ENV, runs, 1.0, 2, tmp_path, looks=(300, 600), seed=4)
+    assert out.updates.tolist() == [0, 3, 0, 4]
+    one = safety.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 4]), (300, 600), seed=4)
+    assert out.change[2:].tolist() == one.change.tolist()
+    assert len(list(tmp_path.glob("*.json"))) == 2

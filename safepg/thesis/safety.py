@@ -25,6 +25,7 @@ import json
 import math
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -309,3 +310,33 @@ def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma
         json.dump({"key": blob, "outcomes": out.to_json()}, f)
     os.replace(tmp, path)
     return out
+
+
+def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, per_run: int, folder: Path,
+                 looks: tuple[int, ...] = MC_LOOKS, alpha: str = MC_ALPHA, seed: int = 0) -> MonteCarloOutcomes:
+    """:func:`cached_monte_carlo_changes` on ``per_run`` updates spread over each run, joined.
+
+    Parameters
+    ----------
+    env : task
+        The task the runs learned on.
+    runs : sequence of arrays (I + 1, m)
+        Each run's parameters in the order visited (a record's ``theta``, or the authors' logged
+        theta column).
+    sigma : float
+        The policies' standard deviation.
+    per_run : int
+        Updates measured per run (:func:`spread_updates`: the first, the last and evenly between).
+    folder : Path
+        Where the measurements are stored.
+
+    Returns
+    -------
+    MonteCarloOutcomes
+        All runs' measured updates in one (``updates`` keeps each run's own indices).
+    """
+    parts = [cached_monte_carlo_changes(folder, env, T, sigma, spread_updates(len(T) - 1, per_run), looks, alpha,
+                                        seed) for T in runs]
+    return MonteCarloOutcomes(*(np.concatenate([getattr(p, f) for p in parts])
+                                for f in ("updates", "change", "lower", "upper", "rollouts", "outcome")),
+                              looks=tuple(looks), alpha=alpha)
