@@ -58,3 +58,23 @@ def test_figure_draws_those_curves():
     band = ax.collections[0].get_paths()[0].vertices[:, 1]
     assert np.nanmax(band) == pytest.approx(np.nanmax(c["ours"]["adaptive"]["hi"]))
     assert ax.get_xlim() == (0, 8000)
+
+
+def test_safety_figure_draws_each_change_and_interval():
+    from safepg.thesis.safety import MonteCarloOutcomes
+
+    def outcomes(change, half):
+        c = np.asarray(change, dtype=float)
+        return MonteCarloOutcomes(np.arange(c.size), c, c - half, c + half, np.full(c.size, 4000),
+                                  np.where(c - half > 0, "raised", "undetermined"), (4000,), "0.01")
+
+    measured = {"their adaptive run": outcomes([0.01, 0.02], 0.005), "our adaptive runs": outcomes([0.03], 0.01),
+                "their fixed-step run": outcomes([-1.0, 2.0, 0.5], 0.4)}
+    fig = overlays.figure_cartpole_safety(measured)
+    left, right = fig.axes
+    points = [line.get_ydata() for line in left.get_lines() if line.get_linestyle() == "None"]
+    assert [p.tolist() for p in points] == [[0.01, 0.02], [0.03]]
+    right_points = [line.get_ydata() for line in right.get_lines() if line.get_linestyle() == "None"]
+    assert right_points[0].tolist() == [-1.0, 2.0, 0.5]
+    segments = right.collections[0].get_segments()  # the error bars
+    assert [tuple(np.round(s[:, 1], 6)) for s in segments] == [(-1.4, -0.6), (1.6, 2.4), (0.1, 0.9)]

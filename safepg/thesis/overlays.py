@@ -6,6 +6,7 @@ of the same setting, from the stored records and the data files, and returns the
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -55,7 +56,8 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     for name, recs in records.items():
         values = measured_on_grid(recs, grid)
         n = np.sum(np.isfinite(values), axis=0)
-        with np.errstate(all="ignore"):
+        with warnings.catch_warnings():  # past every run's end a column is all NaN, and stays NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
             mean = np.nanmean(values, axis=0)
             sd = np.nanstd(values, axis=0, ddof=1)
         half = np.array([t_quantile_975(int(k) - 1) if k > 1 else np.nan for k in n]) * sd / np.sqrt(n)
@@ -90,5 +92,33 @@ def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], lab
     ax.set_xlabel("trajectories")
     ax.set_ylabel("average return over the batch")
     ax.legend(fontsize="small", loc="lower right")
+    fig.tight_layout()
+    return fig
+
+
+def figure_cartpole_safety(measured: Mapping[str, Any]) -> Figure:
+    """Each measured update's change of J with its interval (:func:`safepg.thesis.safety.measure_runs`).
+
+    ``measured`` maps a run's label to its :class:`~safepg.thesis.safety.MonteCarloOutcomes`; labels
+    with "adaptive" go to the left panel, the others (the fixed-step runs) to the right one, each on
+    its own scale. Within a panel the runs follow each other, updates in their order.
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3.6))
+    colours = ("#7d4fb0", "#2e9e5b")
+    for ax, adaptive in zip(axes, (True, False)):
+        x0 = 0
+        names = [n for n in measured if ("adaptive" in n) == adaptive]
+        for name, col in zip(names, colours):
+            out = measured[name]
+            x = x0 + np.arange(out.change.size)
+            ax.errorbar(x, out.change, yerr=[out.change - out.lower, out.upper - out.change], fmt="o", markersize=3,
+                        color=col, elinewidth=1, capsize=0, label=name)
+            x0 += out.change.size + 2
+        ax.axhline(0, color="black", linewidth=0.8)
+        ax.set_xticks([])
+        ax.set_xlabel("measured updates, in order")
+        ax.set_title("adaptive" if adaptive else "fixed step", fontsize="medium")
+        ax.legend(fontsize="x-small")
+    axes[0].set_ylabel(r"$J(\theta_{k+1}) - J(\theta_k)$ (steps)")
     fig.tight_layout()
     return fig
