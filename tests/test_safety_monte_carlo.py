@@ -109,3 +109,13 @@ def test_measure_runs_joins_the_runs(tmp_path):
     one = safety.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 4]), (300, 600), seed=4)
     assert out.change[2:].tolist() == one.change.tolist()
     assert len(list(tmp_path.glob("*.json"))) == 2
+
+
+def test_theorem_assumptions_name_the_two_discounts():
+    from safepg.thesis import experiments as ex
+
+    rows = {r["assumption"]: r for r in safety.theorem_assumptions(ex.get_experiment("table-5.4-authors").configs[0])}
+    row = rows["c written for the discount the simulator optimises"]
+    assert not row["holds"] and "gamma = 1" in row["why"] and "0.9" in row["why"]
+    rows = {r["assumption"]: r for r in safety.theorem_assumptions(ex.get_experiment("table-5.4").configs[0])}
+    assert rows["c written for the discount the simulator optimises"]["holds"]
