@@ -145,9 +145,9 @@ def _authors_run(batch: list[int], J: list[float]) -> AuthorsRun:
                                         "J": np.array(J), "J_hat": np.zeros(len(batch))}, {})
 
 
-def test_lqg2d_band_is_the_95_percent_t_interval() -> None:
+def test_seed_band_of_the_2d_overlays_is_the_95_percent_t_interval() -> None:
     v = np.array([[1.0, 2.0, np.nan], [3.0, 2.0, 5.0], [5.0, 2.0, np.nan]])
-    mean, lo, hi = overlays.lqg2d_band(v)
+    mean, lo, hi = overlays.seed_band95(v)
     np.testing.assert_allclose(mean, [3.0, 2.0, 5.0])
     half = t_quantile_975(2) * 2.0 / math.sqrt(3)
     np.testing.assert_allclose([lo[0], hi[0]], [3 - half, 3 + half])

@@ -210,24 +210,6 @@ def _lqg2d_dark(key: str) -> tuple[float, float, float]:
     return tuple(0.55 * c for c in to_rgb(_LQG2D_COLORS.get(key, "#444444")))
 
 
-def lqg2d_band(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Seed mean and 95% Student-t band of ``values`` (seeds, points), point by point.
-
-    NaN entries (past a run's end) are left out; where fewer than two seeds remain the band
-    is the mean itself.
-    """
-    v = np.asarray(values, dtype=float)
-    n = np.sum(np.isfinite(v), axis=0)
-    with warnings.catch_warnings():  # all-NaN columns and single seeds: NaN, handled below
-        warnings.simplefilter("ignore", RuntimeWarning)
-        mean = np.nanmean(v, axis=0)
-        sd = np.nanstd(v, axis=0, ddof=1)
-    half = np.zeros_like(mean)
-    for k in np.unique(n[n >= 2]):
-        half[n == k] = t_quantile_975(int(k) - 1) * sd[n == k] / np.sqrt(k)
-    return mean, mean - half, mean + half
-
-
 def lqg2d_held(batch_size: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """The value of the batch that holds trajectory T, for T in ``grid`` (1-based); NaN past the end.
 
@@ -260,7 +242,7 @@ def _lqg2d_performance_figure(ours: Mapping[str, tuple[str, Sequence[LearningRec
     grid = _lqg2d_grid({k: recs for k, (_, recs) in ours.items()}, {k: run for k, (_, run) in theirs.items()})
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for key, (label, recs) in ours.items():
-        mean, lo, hi = lqg2d_band(np.array([lqg2d_held(r.batch_size, r.J, grid) for r in recs]))
+        mean, lo, hi = seed_band95(np.array([lqg2d_held(r.batch_size, r.J, grid) for r in recs]))
         color = _LQG2D_COLORS.get(key)
         ax.plot(grid, mean, color=color, label=label, gid=f"ours:{key}", **_LQG2D_OURS)
         ax.fill_between(grid, lo, hi, color=color, alpha=0.25, linewidth=0)
@@ -300,7 +282,7 @@ def _lqg2d_iteration_figure(field: str, ours: Mapping[str, tuple[str, Sequence[L
         for i, r in enumerate(recs):
             values[i, : r.iterations] = getattr(r, field)
         binned = lqg2d_binned(values, width)
-        mean, lo, hi = lqg2d_band(binned)
+        mean, lo, hi = seed_band95(binned)
         # Only where most seeds still run: with one or two seeds left the band is meaningless.
         few = np.sum(np.isfinite(binned), axis=0) < min(3, len(recs))
         mean[few] = lo[few] = hi[few] = np.nan
@@ -410,13 +392,10 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     ours = {}
     for name, recs in records.items():
         values = measured_on_grid(recs, grid)
-        n = np.sum(np.isfinite(values), axis=0)
-        with warnings.catch_warnings():  # past every run's end a column is all NaN, and stays NaN
-            warnings.simplefilter("ignore", RuntimeWarning)
-            mean = np.nanmean(values, axis=0)
-            sd = np.nanstd(values, axis=0, ddof=1)
-        half = np.array([t_quantile_975(int(k) - 1) if k > 1 else np.nan for k in n]) * sd / np.sqrt(n)
-        ours[name] = {"mean": mean, "lo": mean - half, "hi": mean + half, "seeds": len(recs)}
+        mean, lo, hi = seed_band95(values)
+        one = np.sum(~np.isnan(values), axis=0) < 2  # no band drawn where fewer than two seeds remain
+        lo[one] = hi[one] = np.nan
+        ours[name] = {"mean": mean, "lo": lo, "hi": hi, "seeds": len(recs)}
     runs = cartpole_runs()
     authors = {mine: {"trajectories": np.cumsum(runs[theirs]["N"]), "J_hat": np.asarray(runs[theirs]["J_hat"])}
                for mine, theirs in (("adaptive", "adaptive"), ("N=4000", "fixed"))}
