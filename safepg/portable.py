@@ -27,6 +27,7 @@ order fixed by the code. They are meant for the small matrices of the closed for
 
 from __future__ import annotations
 
+import functools
 import math
 from decimal import Context, Decimal
 
@@ -163,6 +164,7 @@ def powers(x: float, n: int) -> np.ndarray:
 _CTX = Context(prec=40)
 
 
+@functools.lru_cache(maxsize=256)  # the bounds ask for the same few constants every iteration
 def log(x: float) -> float:
     """Natural logarithm, computed in decimal software arithmetic and rounded to a float.
 
@@ -174,11 +176,13 @@ def log(x: float) -> float:
     return float(Decimal(float(x)).ln(_CTX))
 
 
+@functools.lru_cache(maxsize=256)
 def exp(x: float) -> float:
     """Exponential in decimal software arithmetic, rounded to a float (see :func:`log`)."""
     return float(Decimal(float(x)).exp(_CTX))
 
 
+@functools.lru_cache(maxsize=256)
 def ipow(x: float, k: int) -> float:
     """x ** k for an integer k >= 0, exact in decimal arithmetic and then rounded once
     (Python's ``**`` calls libm's ``pow``, whose last bit depends on the CPU)."""
@@ -288,5 +292,57 @@ def cos_array(x: np.ndarray | float) -> np.ndarray:
     return _sin_cos_many(a.ravel(), False).reshape(a.shape)
 
 
-__all__ = ["cholesky", "cos", "cos_array", "dot", "exp", "fsum_mean", "ipow", "log", "matmul", "powers",
-           "sin", "sin_array", "solve", "trace"]
+
+# -------------------------------------------------- exponential and logarithm (kernels)
+# For the random-number kernels (safepg.streams): the ziggurat's wedge test and tail. Same
+# recipe as sin and cos: Cody-Waite reduction by ln 2 (the high part has trailing zero bits,
+# so k * part is exact), a Taylor or atanh series by Horner's rule, and an exact scaling by
+# a power of two from a table (np.ldexp builds it bit by bit). Within a few ulp of the
+# correctly rounded value (tests/test_portable.py), the same bits on every CPU.
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
+_INV_LN2 = 1.44269504088896338700e00
+_SQRT_HALF = 0.70710678118654752440
+_POW2_MIN = -1022
+_POW2 = np.ldexp(1.0, np.arange(_POW2_MIN, 1024))
+
+
+@njit(cache=True)
+def exp_kernel(x: float) -> float:
+    """e^x with CPU-independent bits, for |x| <= 700 (0 below, inf above: beyond the kernels' use)."""
+    if x < -700.0:
+        return 0.0
+    if x > 700.0:
+        return math.inf
+    k = math.floor(x * _INV_LN2 + 0.5)
+    r = (x - k * _LN2_HI) - k * _LN2_LO  # |r| <= ln(2)/2 (plus rounding)
+    p = 1.0 / 87178291200.0  # 1/14!
+    for d in (6227020800.0, 479001600.0, 39916800.0, 3628800.0, 362880.0, 40320.0, 5040.0, 720.0, 120.0,
+              24.0, 6.0, 2.0, 1.0, 1.0):
+        p = p * r + 1.0 / d
+    return p * _POW2[int(k) - _POW2_MIN]
+
+
+@njit(cache=True)
+def log_kernel(x: float) -> float:
+    """ln x with CPU-independent bits, for normal x > 0 (the kernels take it of numbers in (0, 1])."""
+    if not x > 0.0:
+        return math.nan if x != 0.0 else -math.inf
+    m = x
+    k = 0
+    while m < _SQRT_HALF:  # exact: multiplying by 2 only changes the exponent
+        m = m * 2.0
+        k -= 1
+    while m > 2.0 * _SQRT_HALF:
+        m = m * 0.5
+        k += 1
+    s = (m - 1.0) / (m + 1.0)  # ln m = 2 atanh(s), |s| <= 0.1716
+    s2 = s * s
+    p = 1.0 / 25.0
+    for d in (23.0, 21.0, 19.0, 17.0, 15.0, 13.0, 11.0, 9.0, 7.0, 5.0, 3.0, 1.0):
+        p = p * s2 + 1.0 / d
+    return k * _LN2_HI + (k * _LN2_LO + 2.0 * s * p)
+
+
+__all__ = ["cholesky", "cos", "cos_array", "dot", "exp", "exp_kernel", "fsum_mean", "ipow", "log", "log_kernel",
+           "matmul", "powers", "sin", "sin_array", "solve", "trace"]

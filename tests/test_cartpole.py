@@ -14,6 +14,7 @@ import pytest
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import ENV_ID, CartPole, step_dynamics
 from safepg.policies import LinearGaussianPolicy
+from safepg.streams import batch_key, trajectory_draws
 
 gym = pytest.importorskip("gymnasium")
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv  # noqa: E402
@@ -101,9 +102,10 @@ def test_termination_thresholds() -> None:
 
 def replay_gymnasium(task: CartPole, gain: np.ndarray, n: int, seed: int) -> dict[str, np.ndarray]:
     """Step n single gymnasium CartPoleEnvs with the simulator's documented random draws."""
-    rng = np.random.default_rng(seed)
-    s0 = rng.uniform(-0.05, 0.05, size=(n, 4))  # drawn first ...
-    noise = rng.standard_normal((n, task.horizon, 1))  # ... then one (n, H, 1) array
+    # One batch key from the seed; trajectory i: 4 uniforms (its initial state), then normals.
+    uniforms, normals = trajectory_draws(batch_key(np.random.default_rng(seed)), n, 4, task.horizon)
+    s0 = -0.05 + 0.1 * uniforms
+    noise = normals[:, :, None]
     H = task.horizon
     out = {k: np.zeros((n, H, 4) if k == "features" else (n, H)) for k in ("features", "raw", "rewards")}
     out["mask"] = np.zeros((n, H), dtype=bool)
@@ -140,9 +142,9 @@ def test_simulate_equals_our_gymnasium_env() -> None:
     gain = np.array([0.3, 1.0, 25.0, 4.0])
     n = 8
     batch = task.simulate_gain(gain, 1.0, n, rng=3)
-    rng = np.random.default_rng(3)
-    s0 = rng.uniform(-0.05, 0.05, size=(n, 4))
-    noise = rng.standard_normal((n, task.horizon, 1))
+    uniforms, normals = trajectory_draws(batch_key(np.random.default_rng(3)), n, 4, task.horizon)
+    s0 = -0.05 + 0.1 * uniforms
+    noise = normals[:, :, None]
     env = ContinuousCartPoleEnv()
     for i in range(n):
         s, _ = env.reset(options={"state": s0[i]})

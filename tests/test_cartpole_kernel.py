@@ -13,6 +13,7 @@ from safepg.envs._cartpole_kernel import CHUNK, cartpole_gradient_samples
 from safepg.envs.cartpole import CartPole
 from safepg.estimators import gradient_samples
 from safepg.policies import LinearGaussianPolicy
+from safepg.streams import batch_key
 
 # Balances the 1 m pole for the whole horizon (the gain of tests/test_cartpole.py).
 STABLE = np.array([1.0, 2.0, 40.0, 8.0])
@@ -121,22 +122,23 @@ def test_returns_are_episode_lengths_and_measured_returns() -> None:
     assert returns.min() >= 1 and returns.max() <= task.horizon
 
 
-def test_kernel_takes_2d_or_3d_noise() -> None:
+def test_kernel_draws_the_batch_of_its_key() -> None:
+    """Called directly with the key gradient_batch draws from a seed, the kernel gives its batch;
+    a bad batch size or horizon is named."""
     task, K, sig = CASES["mixed"]
-    rng = np.random.default_rng(0)
-    s0 = rng.uniform(-0.05, 0.05, size=(40, 4))
-    z = rng.standard_normal((40, task.horizon, 1))
+    pol = LinearGaussianPolicy(K, sig)
     args = (sig, task.pole_length, task.cart_mass, task.pole_mass, task.gravity, task.tau)
     tail = (task.gamma, task.action_bound, task.x_threshold, task.angle_threshold, True, False, True)
-    three = cartpole_gradient_samples(K, *args, s0, z, *tail)
-    two = cartpole_gradient_samples(K, *args, s0, z[:, :, 0], *tail)  # a strided view, copied
-    assert np.array_equal(three[0], two[0]) and np.array_equal(three[1], two[1])
-    with pytest.raises(ValueError, match="^z "):
-        cartpole_gradient_samples(K, *args, s0, np.zeros((40, task.horizon, 2)), *tail)
-    with pytest.raises(ValueError, match="^z "):
-        cartpole_gradient_samples(K, *args, s0, z[:39], *tail)
-    with pytest.raises(ValueError, match="^s0 "):
-        cartpole_gradient_samples(K, *args, s0[:, :3], z, *tail)
+    key = batch_key(np.random.default_rng(3))
+    got = cartpole_gradient_samples(K, *args, key, 40, task.horizon, task.init_bound, *tail)
+    want = task.gradient_batch(pol, 40, 3)
+    assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+    other = cartpole_gradient_samples(K, *args, key + np.uint64(1), 40, task.horizon, task.init_bound, *tail)
+    assert not np.array_equal(other[0], got[0])
+    with pytest.raises(ValueError, match="^n "):
+        cartpole_gradient_samples(K, *args, key, 0, task.horizon, task.init_bound, *tail)
+    with pytest.raises(ValueError, match="^horizon "):
+        cartpole_gradient_samples(K, *args, key, 40, 2.5, task.init_bound, *tail)
 
 
 def test_fused_bad_input() -> None:

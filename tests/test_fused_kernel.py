@@ -10,6 +10,7 @@ from safepg.envs._lqg_kernel import CHUNK, lqg2d_gradient_samples, lqg_gradient_
 from safepg.envs.lqg import LQG
 from safepg.estimators import gradient_samples
 from safepg.policies import LinearGaussianPolicy
+from safepg.streams import batch_key
 
 # Every entry of every 2-D matrix differs, so a swapped index in the unrolled m = 2
 # kernel cannot go unnoticed; Q and R are not symmetric on purpose (the kernels must use
@@ -59,11 +60,9 @@ def test_fused_result_does_not_depend_on_thread_count(case, estimator):
 
 
 def _kernel_inputs(env, pol, n, seed):
-    rng = np.random.default_rng(seed)
-    s0 = rng.uniform(-env.state_bound, env.state_bound, size=(n, env.dim))
-    z = rng.standard_normal((n, env.horizon, env.dim))
+    key = batch_key(np.random.default_rng(seed))  # what gradient_batch draws from this seed
     A, B, Q, R = env._mats
-    return (pol.gain, pol.cov_chol, pol.precision, A, B, Q, R, s0, z,
+    return (pol.gain, pol.cov_chol, pol.precision, A, B, Q, R, key, n, env.horizon,
             env.gamma, env.state_bound, env.action_bound)
 
 

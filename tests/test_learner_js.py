@@ -39,6 +39,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
+from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.live_learner import task_data
 
 NODE = shutil.which("node")
@@ -208,9 +209,10 @@ def test_closed_form_performance_matches_safepg():
 def test_gradient_samples_match_numba_kernel(clip, tmp_path):
     from safepg.envs._lqg_kernel import lqg1d_gradient_samples
 
-    rng = np.random.default_rng(5)
     n, H = 3001, 20  # several of the page's 1024-trajectory chunks
-    s0, z = rng.uniform(-2, 2, (n, 1)), rng.standard_normal((n, H, 1))
+    key = batch_key(np.random.default_rng(5))
+    uniforms, normals = trajectory_draws(key, n, 1, H)  # what the numba kernel draws for this key
+    s0, z = -2.0 + 4.0 * uniforms, normals
     s0.tofile(tmp_path / "s0.bin")
     z.tofile(tmp_path / "z.bin")
     cases = [{"theta": th, "sigma": sg, "estimator": est, "baseline": bl, "score": sc, "clip": clip}
@@ -218,7 +220,7 @@ def test_gradient_samples_match_numba_kernel(clip, tmp_path):
              for bl in (True, False) for sc in ("clipped", "raw")]
     got = run_node({"kernel": {"s0": str(tmp_path / "s0.bin"), "z": str(tmp_path / "z.bin"), "cases": cases}})["kernel"]
     for q, js in zip(cases, got):
-        samples, returns = lqg1d_gradient_samples(q["theta"], q["sigma"], 1.0, 1.0, 1.0, 1.0, s0, z, 0.9, 2.0, 2.0,
+        samples, returns = lqg1d_gradient_samples(q["theta"], q["sigma"], 1.0, 1.0, 1.0, 1.0, key, n, H, 0.9, 2.0, 2.0,
                                                   clip, q["score"] == "clipped", q["estimator"] == "reinforce",
                                                   q["baseline"])
         scale = np.max(np.abs(samples))  # a baseline-corrected sample near 0 is compared at the batch's scale
@@ -228,17 +230,18 @@ def test_gradient_samples_match_numba_kernel(clip, tmp_path):
 
 @pytest.mark.parametrize("bound,er,estimator", [("chebyshev", False, "gpomdp"), ("bernstein", True, "gpomdp"),
                                                 ("hoeffding", True, "reinforce"), ("bernstein", True, "reinforce")])
-def test_whole_run_with_numpys_random_numbers(bound, er, estimator, tmp_path):
+def test_whole_run_with_safepgs_random_numbers(bound, er, estimator, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     env, budget, seed, sigma, delta = LQG.thesis_1d(), 60_000, 4, 0.8, 0.6
     py = adaptive_pg(env, 0.0, sigma, estimator=estimator, bound=bound, empirical_range=er, delta=delta,
                      budget=budget, rng=seed)
-    # Redraw the same numbers: per batch, n initial states, then an (n, H, 1) array of normals.
+    # Redraw the same numbers: per batch, one key; trajectory i: its initial state, then H normals.
     rng = np.random.default_rng(seed)
     s0, z = [], []
     for n in py.batch_size:
-        s0.append(rng.uniform(-2, 2, n))
-        z.append(rng.standard_normal((n, env.horizon, 1)).ravel())
+        uniforms, normals = trajectory_draws(batch_key(rng), int(n), 1, env.horizon)
+        s0.append(-2.0 + 4.0 * uniforms[:, 0])
+        z.append(normals.ravel())
     np.concatenate(s0).tofile(tmp_path / "s0.bin")
     np.concatenate(z).tofile(tmp_path / "z.bin")
     cfg = {"sigma": sigma, "estimator": estimator, "bound": bound, "empiricalRange": er, "delta": delta,

@@ -4,8 +4,10 @@ The reference path (``CartPole.simulate`` then :mod:`safepg.estimators`) steps e
 cart for as long as *any* cart is alive and then makes a dozen passes over (N, H, 4)
 arrays, most of whose entries are the zeros of dead steps. This kernel follows one
 trajectory at a time and stops at its last step, and gives the same numbers up to
-floating-point rounding (tested). The random numbers are drawn by the caller from the
-same ``numpy.random.Generator`` in the same order, so both paths see the same batch.
+floating-point rounding (tested). Each trajectory draws its initial state and its action
+noise inside the loop from its own counter-based stream (:mod:`safepg.streams`), as many
+normals as it lives steps; the reference path reads the same streams, so both paths see
+the same batch.
 
 Two things need care when the time loop stops early:
 
@@ -16,8 +18,8 @@ Two things need care when the time loop stops early:
   their running sum over T <= l.
 - Pass 2 subtracts :math:`\sum_l G_{n,l} b_l`; the dead steps contribute
   :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps are recomputed by
-  simulating the trajectory again from the same initial state and noise (the same code,
-  so the same bits) instead of keeping an (N, H, 4) array of cumulative scores.
+  simulating the trajectory again from the start of its stream (the same numbers, the same
+  code, so the same bits) instead of keeping an (N, H, 4) array of cumulative scores.
 
 As in :mod:`safepg.envs._lqg_kernel`, trajectories are processed in fixed-size chunks in
 parallel; every chunk writes its own partial sums and the chunks are reduced in order,
@@ -30,6 +32,7 @@ import numpy as np
 from numba import njit, prange
 
 from safepg import portable
+from safepg.streams import next_normal, next_uniform, stream_start
 
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
@@ -71,17 +74,30 @@ def _step(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, 
 
 
 @njit(cache=True)
-def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, x_threshold, angle_threshold,
+def _initial_state(key, n, init_bound):
+    """Trajectory n's initial state, uniform on [-init_bound, init_bound)^4, and its stream."""
+    state = stream_start(key, n)
+    width = init_bound + init_bound
+    v0, state = next_uniform(state)
+    v1, state = next_uniform(state)
+    v2, state = next_uniform(state)
+    v3, state = next_uniform(state)
+    return (-init_bound + width * v0, -init_bound + width * v1, -init_bound + width * v2,
+            -init_bound + width * v3, state)
+
+
+@njit(cache=True)
+def _first_pass(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, gamma, action_bound, x_threshold,
+                angle_threshold,
                 score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept,
                 semi_implicit, peak):
     """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
     lengths, their largest |state component| (``peak``, the initial and the final state
     included), and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
-    H = zz.shape[1]
     half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
     for n in range(lo, hi):
-        x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
+        x, x_dot, beta, beta_dot, state = _initial_state(key, n, init_bound)
         p0, p1, p2, p3 = abs(x), abs(x_dot), abs(beta), abs(beta_dot)
         g0 = g1 = g2 = g3 = 0.0  # cumulative scores
         a0 = a1 = a2 = a3 = 0.0  # G(PO)MDP sample without baseline
@@ -90,7 +106,8 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
         T = H
         for t in range(H):
             mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            a_raw = mean + sigma * zz[n, t]
+            zt, state = next_normal(state)
+            a_raw = mean + sigma * zt
             u = min(max(a_raw, -action_bound), action_bound)
             d = ((u if score_clipped else a_raw) - mean) * inv_var
             g0 += d * x
@@ -147,20 +164,21 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, gamma, action_bound, 
 
 
 @njit(cache=True)
-def _second_pass(lo, hi, K, sigma, inv_var, consts, s0, zz, action_bound, score_clipped, b, suffix,
+def _second_pass(lo, hi, K, sigma, inv_var, consts, key, init_bound, action_bound, score_clipped, b, suffix,
                  samples, lengths, semi_implicit):
     """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again."""
     half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
     for n in range(lo, hi):
-        x, x_dot, beta, beta_dot = s0[n, 0], s0[n, 1], s0[n, 2], s0[n, 3]
+        x, x_dot, beta, beta_dot, state = _initial_state(key, n, init_bound)
         g0 = g1 = g2 = g3 = 0.0
         a0 = a1 = a2 = a3 = 0.0  # sum_l G_l b_l over the live steps
         T = int(lengths[n])
         # Pass 1's trajectory again, operation for operation: it ends at T, no need to test.
         for t in range(T):
             mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            a_raw = mean + sigma * zz[n, t]
+            zt, state = next_normal(state)
+            a_raw = mean + sigma * zt
             u = min(max(a_raw, -action_bound), action_bound)
             d = ((u if score_clipped else a_raw) - mean) * inv_var
             g0 += d * x
@@ -221,8 +239,9 @@ def _baseline(num, den, ended, gpomdp_baseline):
 
 
 def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, cart_mass: float,
-                              pole_mass: float, gravity: float, tau: float, s0: np.ndarray, z: np.ndarray,
-                              gamma: float, action_bound: float, x_threshold: float, angle_threshold: float,
+                              pole_mass: float, gravity: float, tau: float, key: np.uint64, n: int,
+                              horizon: int, init_bound: float, gamma: float, action_bound: float,
+                              x_threshold: float, angle_threshold: float,
                               score_clipped: bool, reinforce_estimator: bool,
                               baseline: bool, semi_implicit: bool = False, polemass_length: float | None = None,
                               peaks: bool = False) -> tuple[np.ndarray, ...]:
@@ -236,10 +255,14 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         Action standard deviation.
     pole_length, cart_mass, pole_mass, gravity, tau : float
         Physical constants (whole pole length, as in :class:`CartPole`).
-    s0 : ndarray, shape (N, 4)
-        Initial states.
-    z : ndarray, shape (N, H) or (N, H, 1)
-        Standard normals of the actions.
+    key : uint64
+        The batch's key (:func:`safepg.streams.batch_key`): trajectory i draws its initial
+        state (4 uniforms on [-init_bound, init_bound)) and then one standard normal per
+        step it lives from stream i of this key.
+    n, horizon : int
+        Batch size N and horizon H.
+    init_bound : float
+        Half-width of the initial-state box.
     gamma : float
         Discount factor of the estimators.
     action_bound, x_threshold, angle_threshold : float
@@ -266,30 +289,27 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         state to the last one reached (the failing state, or s_H), component by component.
     """
     # One compiled specialisation only: numba compiles again (about 10 s) for every new
-    # combination of argument types, e.g. a 3-D z, an int constant or a numpy bool flag.
+    # combination of argument types, e.g. an int constant or a numpy bool flag.
     K = np.ascontiguousarray(K, dtype=np.float64).reshape(4)
-    s0 = np.ascontiguousarray(s0, dtype=np.float64)
-    z = np.asarray(z, dtype=np.float64)
-    if s0.ndim != 2 or s0.shape[1] != 4:
-        raise ValueError(f"s0 must have shape (N, 4), got {s0.shape}")
-    if not (z.ndim == 2 or (z.ndim == 3 and z.shape[2] == 1)) or z.shape[0] != s0.shape[0]:
-        raise ValueError(f"z must have shape (N, H) or (N, H, 1) with N = {s0.shape[0]}, got {z.shape}")
-    zz = np.ascontiguousarray(z.reshape(z.shape[0], z.shape[1]))
+    if int(n) != n or n < 1:
+        raise ValueError(f"n must be a positive integer, got {n}")
+    if int(horizon) != horizon or horizon < 1:
+        raise ValueError(f"horizon must be a positive integer, got {horizon}")
     half = 0.5 * float(pole_length)
     # pole_mass * half is the product the consistent equations form first: the same bits.
     ml = float(pole_mass) * half if polemass_length is None else float(polemass_length)
     samples, lengths, peak = _fused(K, float(sigma), half, ml, float(cart_mass), float(pole_mass), float(gravity),
-                                    float(tau), s0, zz, float(gamma), float(action_bound), float(x_threshold),
+                                    float(tau), np.uint64(key), int(n), int(horizon), float(init_bound),
+                                    float(gamma), float(action_bound), float(x_threshold),
                                     float(angle_threshold), bool(score_clipped), bool(reinforce_estimator),
                                     bool(baseline), bool(semi_implicit))
     return (samples, lengths, peak) if peaks else (samples, lengths)
 
 
 @njit(cache=True, parallel=True)
-def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, s0, zz, gamma, action_bound, x_threshold,
-           angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
-    """:func:`cartpole_gradient_samples` on normalised arguments (zz is (N, H))."""
-    N, H = zz.shape[0], zz.shape[1]
+def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, init_bound, gamma, action_bound,
+           x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
+    """:func:`cartpole_gradient_samples` on normalised arguments."""
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.zeros((N, 4))
     lengths = np.empty(N)
@@ -310,7 +330,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, s0, zz, gamma
     for c in prange(n_chunks):
         i = c * i_step
         j = c * j_step
-        _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, gamma,
+        _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, gamma,
                     action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
                     samples, lengths, num[i], den[i], ended[j], kept, semi_implicit, peak)
     if not baseline:
@@ -324,6 +344,6 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, s0, zz, gamma
         return samples, lengths, peak
 
     for c in prange(n_chunks):
-        _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, s0, zz, action_bound,
+        _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, init_bound, action_bound,
                      score_clipped, b, suffix, samples, lengths, semi_implicit)
     return samples, lengths, peak

@@ -2,9 +2,11 @@
 
 The reference path (``LQG.simulate`` then :mod:`safepg.estimators`) materialises
 several (N, H, m) arrays and makes a dozen passes over them; this kernel makes one pass
-per trajectory and gives the same numbers up to floating-point rounding (tested). The
-random numbers are drawn by the caller from the same ``numpy.random.Generator`` in the
-same order, so both paths see the same batch.
+per trajectory and gives the same numbers up to floating-point rounding (tested). Each
+trajectory draws its own random numbers inside the loop, from its counter-based stream
+(:mod:`safepg.streams`: the batch key and the trajectory's index), so no (N, H, m) array
+of normals is ever formed; the reference path reads the same streams through
+:func:`safepg.streams.trajectory_draws`, so both paths see the same batch.
 
 Trajectories are processed in fixed-size chunks in parallel; every chunk writes its own
 partial sums and the chunks are reduced in order, so the result does not depend on the
@@ -16,18 +18,19 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from safepg.streams import next_normal, next_uniform, stream_start
+
 CHUNK = 2048
 
 
 @njit(cache=True, parallel=True)
-def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, s0, z, gamma, bs, ba, clip, score_clipped,
+def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                            reinforce_estimator, baseline):
     """Scalar (m = 1) version of :func:`lqg_gradient_samples`.
 
     Section 5.1's campaign is almost all scalar steps; with scalars in registers this
     runs about twice as fast as the matrix loops below at m = 1.
     """
-    N, H = z.shape[0], z.shape[1]
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.empty((N, 1))
     returns = np.empty(N)
@@ -38,14 +41,17 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, s0, z, gamma, bs, ba, clip,
     inv_var = 1.0 / (sigma * sigma)
     for c in prange(n_chunks):
         for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-            s = s0[n, 0]
+            state = stream_start(key, n)
+            u0, state = next_uniform(state)
+            s = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
             cum = 0.0
             acc = 0.0
             disc = 1.0
             ret = 0.0
             for t in range(H):
                 mean = theta * s
-                a_raw = mean + sigma * z[n, t, 0]
+                zt, state = next_normal(state)
+                a_raw = mean + sigma * zt
                 u = min(max(a_raw, -ba), ba) if clip else a_raw
                 dr = -0.5 * (Q * s * s + R * u * u) * disc
                 ret += dr
@@ -80,7 +86,7 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, s0, z, gamma, bs, ba, clip,
 
 
 @njit(cache=True, parallel=True)
-def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score_clipped,
+def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                            reinforce_estimator, baseline):
     """Two-dimensional (m = 2) version of :func:`lqg_gradient_samples`.
 
@@ -90,7 +96,7 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, sco
     strides, which dominates at m = 2. Here the 2 x 2 algebra is unrolled: the matrices
     are read once into locals and the per-trajectory state (s, a, u, the four cumulative
     scores, the four sample sums) lives in registers. The only per-step memory traffic
-    left is reading z[n, t, :], adding to the chunk's L1-resident baseline sums
+    left is adding to the chunk's L1-resident baseline sums
     num/den[c, t, :] and, with a G(PO)MDP baseline, storing the four cumulative scores
     kept[n, t, :] contiguously (pass 2 needs them).
 
@@ -105,10 +111,12 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, sco
     K, L, Pm, A, B, Q, R : ndarray (2, 2)
         Gain, lower Cholesky factor of the policy covariance (its upper entry is not
         read), precision, dynamics and cost matrices.
-    s0 : ndarray (N, 2)
-        Initial states.
-    z : ndarray (N, H, 2)
-        Standard normals; the action noise is L z.
+    key : uint64
+        The batch's key (:func:`safepg.streams.batch_key`): trajectory n draws its initial
+        state (2 uniforms) and then its standard normals z (2 per step; the action noise
+        is L z) from stream n of this key.
+    N, H : int
+        Batch size and horizon.
     gamma, bs, ba : float
         Discount, state and action box half-widths.
     clip, score_clipped, reinforce_estimator, baseline : bool
@@ -121,7 +129,6 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, sco
     returns : ndarray (N,)
         Discounted returns.
     """
-    N, H = z.shape[0], z.shape[1]
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.empty((N, 4))
     returns = np.empty(N)
@@ -138,8 +145,11 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, sco
     r00, r01, r10, r11 = R[0, 0], R[0, 1], R[1, 0], R[1, 1]
     for c in prange(n_chunks):
         for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-            x0 = s0[n, 0]
-            x1 = s0[n, 1]
+            state = stream_start(key, n)
+            v0, state = next_uniform(state)
+            v1, state = next_uniform(state)
+            x0 = -bs + (bs + bs) * v0
+            x1 = -bs + (bs + bs) * v1
             g00 = 0.0
             g01 = 0.0
             g10 = 0.0
@@ -153,8 +163,8 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, sco
             for t in range(H):
                 m0 = k00 * x0 + k01 * x1
                 m1 = k10 * x0 + k11 * x1
-                z0 = z[n, t, 0]
-                z1 = z[n, t, 1]
+                z0, state = next_normal(state)
+                z1, state = next_normal(state)
                 a0 = m0 + l00 * z0
                 a1 = m1 + (l10 * z0 + l11 * z1)
                 if clip:
@@ -279,7 +289,7 @@ def _baseline(num, den):
 
 
 @njit(cache=True, parallel=True)
-def lqg_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score_clipped,
+def lqg_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                          reinforce_estimator, baseline):
     """Per-trajectory REINFORCE or G(PO)MDP samples (N, m*m) and discounted returns (N,).
 
@@ -288,7 +298,7 @@ def lqg_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score
     sum_l G_l gamma^l r_l (G(PO)MDP) or S * ret (REINFORCE). Pass 2 subtracts the
     baseline term using the cumulative scores kept from pass 1.
     """
-    N, H, m = z.shape[0], z.shape[1], z.shape[2]
+    m = K.shape[0]
     M = m * m
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.zeros((N, M))
@@ -306,14 +316,19 @@ def lqg_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score
         u = np.empty(m)
         diff = np.empty(m)
         cum = np.empty(M)
+        zt = np.empty(m)
         for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
+            state = stream_start(key, n)
             for i in range(m):
-                s[i] = s0[n, i]
+                v, state = next_uniform(state)
+                s[i] = -bs + (bs + bs) * v
             for p in range(M):
                 cum[p] = 0.0
             disc = 1.0
             ret = 0.0
             for t in range(H):
+                for i in range(m):
+                    zt[i], state = next_normal(state)
                 for i in range(m):
                     acc = 0.0
                     for j in range(m):
@@ -321,7 +336,7 @@ def lqg_gradient_samples(K, L, Pm, A, B, Q, R, s0, z, gamma, bs, ba, clip, score
                     mean[i] = acc
                     acc = 0.0
                     for j in range(i + 1):
-                        acc += L[i, j] * z[n, t, j]
+                        acc += L[i, j] * zt[j]
                     a_raw[i] = mean[i] + acc
                     u[i] = min(max(a_raw[i], -ba), ba) if clip else a_raw[i]
                 cost = 0.0

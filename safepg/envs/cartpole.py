@@ -68,6 +68,7 @@ from safepg.constants import HORIZON_TERMS
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
+from safepg.streams import batch_key, trajectory_draws
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -430,8 +431,10 @@ class CartPole:
         std = float(policy.cov_chol[0, 0])
         scale = None if self.feature_scale is None else np.asarray(self.feature_scale)
 
-        s = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
-        noise = rng.standard_normal((n, H, 1))
+        # Trajectory i reads stream i of one batch key (safepg.streams), as the fused kernel does.
+        uniforms, normals = trajectory_draws(batch_key(rng), n, self.state_dim, H)
+        s = -self.init_bound + (self.init_bound + self.init_bound) * uniforms
+        noise = normals[:, :, None]
 
         # Time-major buffers, so step t writes one contiguous block; transposed once at the end.
         feats = np.zeros((H, n, self.state_dim))
@@ -556,8 +559,6 @@ class CartPole:
         check_estimator(estimator)
         check_score_action(score_action)
         rng = as_generator(rng)
-        s0 = rng.uniform(-self.init_bound, self.init_bound, size=(n, self.state_dim))
-        z = rng.standard_normal((n, self.horizon, self.action_dim))
         gain = policy.gain[0]
         if self.feature_scale is not None:
             # theta^T (s / scale) = (theta / scale)^T s: the kernel runs on the raw state with
@@ -568,7 +569,8 @@ class CartPole:
         # The wrapper normalises the argument types (one compiled specialisation).
         out = cartpole_gradient_samples(
             gain, policy.cov_chol[0, 0], self.pole_length, self.cart_mass, self.pole_mass, self.gravity,
-            self.tau, s0, z, self.gamma, self.action_bound, self.x_threshold, self.angle_threshold,
+            self.tau, batch_key(rng), n, self.horizon, self.init_bound, self.gamma, self.action_bound,
+            self.x_threshold, self.angle_threshold,
             score_action == "clipped", estimator == "reinforce", baseline,
             semi_implicit=self.integrator == "semi-implicit", polemass_length=self.polemass_length, peaks=peaks)
         samples, returns = out[0], out[1]

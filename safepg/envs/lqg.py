@@ -25,6 +25,7 @@ from safepg import portable
 from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
+from safepg.streams import batch_key, trajectory_draws
 from safepg.trajectories import Trajectories
 
 
@@ -126,8 +127,9 @@ class LQG:
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
         """Simulate ``n`` trajectories of length H at once.
 
-        Random numbers are drawn in a fixed order (initial states, then an (n, H, m)
-        array of standard normals), so a seed fixes the batch bit for bit.
+        Trajectory i reads stream i of one batch key drawn from ``rng``
+        (:mod:`safepg.streams`): its initial state, then its standard normals step by
+        step. A seed fixes the batch bit for bit, and :meth:`gradient_batch` sees the same one.
         """
         self._check_policy(policy)
         if int(n) != n or n < 1:
@@ -135,9 +137,10 @@ class LQG:
         rng = as_generator(rng)
         A, B, Q, R = self._mats
         m, H, bs, ba = self.dim, self.horizon, self.state_bound, self.action_bound
-        s = rng.uniform(-bs, bs, size=(n, m))
+        uniforms, normals = trajectory_draws(batch_key(rng), n, m, H * m)
+        s = -bs + (bs + bs) * uniforms  # the fused kernels' uniform on [-bs, bs)
         mm = portable.matmul  # fixed-order products: the batch is the same on every CPU
-        raw = mm(rng.standard_normal((n, H, m)), policy.cov_chol.T)
+        raw = mm(normals.reshape(n, H, m), policy.cov_chol.T)
         feats = np.empty((n, H, m))
         acts = np.empty((n, H, m))
         rews = np.empty((n, H))
@@ -325,7 +328,7 @@ class LQG:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Gradient samples (n, m) and discounted returns (n,) of a fresh batch, fused.
 
-        Same random numbers, in the same order, as :meth:`simulate`, and the same numbers
+        Same random numbers as :meth:`simulate` (one batch key from ``rng``), and the same numbers
         as ``gradient_samples(policy, simulate(...), ...)`` up to rounding, without
         materialising the trajectories (see :mod:`safepg.envs._lqg_kernel`).
         """
@@ -338,14 +341,13 @@ class LQG:
         check_score_action(score_action)
         rng = as_generator(rng)
         A, B, Q, R = self._mats
-        s0 = rng.uniform(-self.state_bound, self.state_bound, size=(n, self.dim))
-        z = rng.standard_normal((n, self.horizon, self.dim))
+        head = (batch_key(rng), int(n), int(self.horizon))
         flags = (float(self.gamma), float(self.state_bound), float(self.action_bound), bool(self.clip),
                  score_action == "clipped", estimator == "reinforce", bool(baseline))
         if self.dim == 1:
             return lqg1d_gradient_samples(
                 float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
-                float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), s0, z, *flags)
+                float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
         # m = 2 (Section 5.2) has its own unrolled kernel; m >= 3 uses the generic loops.
         kernel = lqg2d_gradient_samples if self.dim == 2 else lqg_gradient_samples
-        return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, s0, z, *flags)
+        return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)

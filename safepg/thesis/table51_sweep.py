@@ -56,6 +56,7 @@ from numba import njit
 
 from safepg.envs.lqg import LQG
 from safepg.rng import RNGLike, as_generator
+from safepg.streams import batch_key, next_normal, next_uniform, stream_start
 
 Baseline = Literal["none", "optimal", "average"]
 SigmaReading = Literal["std", "variance"]
@@ -64,7 +65,8 @@ Objective = Literal["J", "simulated"]
 
 _BASELINE_CODES = {"none": 0, "optimal": 1, "average": 2}
 #: Bump when a change here alters the numbers a sweep run produces (stored sweeps are recomputed).
-SWEEP_VERSION = "1"
+#: 2: the counter-based streams of safepg.streams instead of NumPy's draws.
+SWEEP_VERSION = "2"
 
 
 @dataclass(frozen=True)
@@ -109,9 +111,8 @@ def _check_positive(name: str, value: float) -> None:
 
 # ----------------------------------------------------------------------------- gradient
 @njit(cache=True)
-def _batch_gradient(theta: float, std: float, s0: np.ndarray, z: np.ndarray, gamma: float, bound: float,
+def _batch_gradient(theta: float, std: float, key: np.uint64, N: int, H: int, gamma: float, bound: float,
                     score_clipped: bool, baseline: int) -> tuple[float, float]:  # pragma: no cover - numba
-    N, H = z.shape
     s1 = np.zeros(H)    # sum_n cum * gamma^t r_t
     scum = np.zeros(H)  # sum_n cum
     num = np.zeros(H)   # sum_n cum^2 gamma^t r_t  (variance-minimising baseline)
@@ -120,12 +121,15 @@ def _batch_gradient(theta: float, std: float, s0: np.ndarray, z: np.ndarray, gam
     inv_var = 1.0 / (std * std)
     ret = 0.0
     for n in range(N):
-        s = s0[n]
+        state = stream_start(key, n)
+        v, state = next_uniform(state)
+        s = -bound + (bound + bound) * v  # the library's initial state (safepg.envs.lqg)
         cum = 0.0
         disc = 1.0
         for t in range(H):
             mean = theta * s
-            a = mean + std * z[n, t]
+            zt, state = next_normal(state)
+            a = mean + std * zt
             u = min(max(a, -bound), bound)
             dr = -0.5 * (s * s + u * u) * disc
             cum += ((u if score_clipped else a) - mean) * s * inv_var
@@ -152,8 +156,8 @@ def batch_gradient(env: LQG, theta: float, std: float, n: int, rng: RNGLike, bas
                    score_action: str = "clipped") -> tuple[float, float]:
     """G(PO)MDP batch estimate of dJ/dtheta and the batch's mean discounted return (1-D LQG).
 
-    Draws the random numbers in the library's order (initial states (n, 1), then
-    standard normals (n, H, 1)), so with the same generator state and the
+    Draws the library's random numbers (one batch key from ``rng``, trajectory i on its
+    stream i, see :mod:`safepg.streams`), so with the same generator state and the
     ``"optimal"`` or ``"none"`` baseline it matches
     ``env.gradient_batch(..., "gpomdp", baseline, score_action)[0].mean()`` to rounding.
 
@@ -177,10 +181,8 @@ def batch_gradient(env: LQG, theta: float, std: float, n: int, rng: RNGLike, bas
     if int(n) != n or n < 1:
         raise ValueError(f"n must be a positive integer, got {n}")
     rng = as_generator(rng)
-    s0 = rng.uniform(-env.state_bound, env.state_bound, size=(n, 1))[:, 0]
-    z = rng.standard_normal((n, env.horizon, 1))[:, :, 0]
-    g, ret = _batch_gradient(float(theta), float(std), s0, z, float(env.gamma), float(env.state_bound),
-                             score_action == "clipped", _BASELINE_CODES[baseline])
+    g, ret = _batch_gradient(float(theta), float(std), batch_key(rng), int(n), int(env.horizon), float(env.gamma),
+                             float(env.state_bound), score_action == "clipped", _BASELINE_CODES[baseline])
     return float(g), float(ret)
 
 
