@@ -2,8 +2,9 @@
 
 One iteration = simulate N trajectories (H = 20), G(PO)MDP samples with baseline,
 Bernstein bound with empirical range, coordinate step and N* search. The floor is the
-time to draw the random numbers that iteration consumes (N uniforms + N*H normals)
-with the same generator. Run: ``python benchmarks/bench_iteration.py [--repeat R]``.
+time NumPy's default generator (PCG64) takes to draw the random numbers that iteration
+consumes (N uniforms + N*H normals); the kernel draws its own (safepg.streams).
+Run: ``python benchmarks/bench_iteration.py [--repeat R]``.
 
 ``--kernel2d`` instead times the 2-D LQG gradient kernels single-threaded (generic m x m
 loops against the unrolled m = 2 kernel) at N = 100 and 2000, H = 20, in ns per
@@ -27,6 +28,7 @@ from safepg.envs.lqg import LQG
 from safepg.estimators import gradient_samples
 from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant
 from safepg.policies import LinearGaussianPolicy
+from safepg.streams import batch_key
 
 FUSED = True
 
@@ -81,10 +83,8 @@ def kernel2d(repeat: int, vanilla: bool) -> list[dict]:
     kernels = {"generic": lqg_gradient_samples, "m=2": lqg2d_gradient_samples}
     rows = []
     for n in (100, 2000):
-        rng = np.random.default_rng(0)
-        s0 = rng.uniform(-2, 2, size=(n, 2))
-        z = rng.standard_normal((n, env.horizon, 2))
-        args = (pol.gain, pol.cov_chol, pol.precision, A, B, Q, R, s0, z, env.gamma, env.state_bound,
+        key = batch_key(np.random.default_rng(0))  # the kernels draw the batch's numbers themselves
+        args = (pol.gain, pol.cov_chol, pol.precision, A, B, Q, R, key, n, env.horizon, env.gamma, env.state_bound,
                 env.action_bound, True, True, False, True)  # G(PO)MDP with baseline, as the campaign
         best = {}
         for name, f in kernels.items():

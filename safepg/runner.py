@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -275,6 +277,7 @@ def run_configs(
     # budgets keep the given order.
     todo.sort(key=lambda ck: -ck[0].budget)
     if todo:
+        started = time.perf_counter()
         n_jobs = effective_n_jobs(jobs)
         tasks = (delayed(_compute_task)(i, c, k, None if c.warm_start is None else starts[c.name][k], n_jobs > 1)
                  for i, (c, k) in enumerate(todo))
@@ -285,4 +288,18 @@ def run_configs(
                 c, k = todo[i]
                 store_run(rec, folder, c, k)
                 bar.update()
+        record_timing(folder, time.perf_counter() - started, len(todo), n_jobs)
     return load_configs(configs, seeds, folder)
+
+
+#: One line per call of :func:`run_configs` that computed runs in a folder: how long it took.
+TIMING_FILE = "timing.jsonl"
+
+
+def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
+    """Append {seconds, runs, jobs, cores, version} to ``folder/timing.jsonl``
+    (benchmarks/bench_book.py sets these against the random-number floor)."""
+    line = json.dumps({"seconds": round(seconds, 3), "runs": runs, "jobs": jobs, "cores": os.cpu_count(),
+                       "results_version": RESULTS_VERSION})
+    with open(folder / TIMING_FILE, "a") as f:
+        f.write(line + "\n")

@@ -460,3 +460,16 @@ def test_partly_computed_store_is_not_judged(store):
                                                     "section-5.1/improvement", "section-5.2/theta-final"))]
     assert measured and all(r.status == "open" for r in measured), [r.id for r in measured if r.status != "open"]
     assert any("2 of 3 seeds" in r.explanation for r in measured)
+
+
+def test_rows_of_some_pages_equal_the_full_cards_rows(store):
+    """``pages`` keeps the rows linking to those pages, in the card's order; a theory page's
+    rows (all closed forms) come without reading any run, the same rows as the full card's."""
+    root, exps, rows = store
+    page_of = {r.id: r.link.split(".html", 1)[0] for r in rows}
+    assert set(page_of.values()) <= BOOK_PAGES
+    for page in sorted(BOOK_PAGES - set(sc.RUN_PAGES)):
+        want = [r for r in rows if page_of[r.id] == page]
+        assert want and sc.scorecard(root, experiments=exps, pages=[page]) == want
+    want = [r for r in rows if page_of[r.id] in ("lqg2d", "errata")]
+    assert sc.scorecard(root, experiments=exps, pages=("lqg2d", "errata")) == want

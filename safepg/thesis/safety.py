@@ -25,6 +25,7 @@ import json
 import math
 import os
 import tempfile
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -307,11 +308,13 @@ def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma
             return MonteCarloOutcomes.from_json(stored["outcomes"])
     except (OSError, ValueError, KeyError, TypeError):
         pass
+    started = time.perf_counter()
     out = monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
+    seconds = time.perf_counter() - started  # benchmarks/bench_book.py reads it
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{key}~", suffix=".tmp")
     with os.fdopen(fd, "w") as f:
-        json.dump({"key": blob, "outcomes": out.to_json()}, f)
+        json.dump({"key": blob, "outcomes": out.to_json(), "seconds": round(seconds, 3)}, f)
     os.replace(tmp, path)
     return out
 

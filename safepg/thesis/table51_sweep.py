@@ -46,6 +46,7 @@ import hashlib
 import json
 import os
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -361,11 +362,16 @@ def sweep_paths(plan: Sequence[tuple[Variant, float]] = CHAPTER_PLAN, seeds: int
              if not (s == 1.0 and v.sigma_reading == "variance")]
     # Longest runs (N = 100: 10^4 updates) first keeps the workers busy to the end.
     tasks.sort(key=lambda task: task[3])
+    started = time.perf_counter()
     out = Parallel(n_jobs=jobs)(delayed(run_cell)(v, s, n, a, k, budget, t) for v, t, s, n, a, k in tasks)
+    seconds = time.perf_counter() - started
     paths: dict[str, dict[str, dict[str, list[list[float]]]]] = {}
     for (v, t, s, n, a, _k), pth in sorted(zip(tasks, out), key=lambda x: x[0][-1]):
         paths.setdefault(v.label, {}).setdefault(_theta0_key(t), {}).setdefault(cell_name(s, n, a), []).append(pth)
-    result = {"plan": spec, "seeds": seeds, "budget": budget, "paths": paths}
+    # What it cost (benchmarks/bench_book.py): every batch before the last parameter is n trajectories.
+    trajectories = sum(n * (len(pth) - 1) for (_v, _t, _s, n, _a, _k), pth in zip(tasks, out))
+    result = {"plan": spec, "seeds": seeds, "budget": budget, "paths": paths, "seconds": round(seconds, 3),
+              "jobs": jobs, "trajectories": trajectories}
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
     with os.fdopen(fd, "w") as f:

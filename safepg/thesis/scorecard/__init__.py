@@ -54,7 +54,14 @@ from safepg.thesis.scorecard.export import (
 )
 from safepg.thesis.scorecard.links import BOOK, book_link
 from safepg.thesis.scorecard.page import group_html, summary_html
-from safepg.thesis.scorecard.rows import AUTHORS_VARIANTS, NEEDED, RANGE_VARIANTS, THETA0_VARIANTS, scorecard
+from safepg.thesis.scorecard.rows import (
+    AUTHORS_VARIANTS,
+    NEEDED,
+    RANGE_VARIANTS,
+    RUN_PAGES,
+    THETA0_VARIANTS,
+    scorecard,
+)
 from safepg.thesis.scorecard.rules import (
     AUTHORS_STATUS,
     GROUPS,
@@ -81,7 +88,8 @@ from safepg.thesis.scorecard.rules import (
 
 __all__ = [
     "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "GROUPS", "JUDGED_ON", "NEEDED", "NOTES", "PRINTED",
-    "RANGE_VARIANTS", "RATIO_POINTS", "RULES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
+    "RANGE_VARIANTS", "RATIO_POINTS", "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS",
+    "THEORY_LABELS",
     "THETA0_VARIANTS", "Note", "Row", "Status", "book_link", "counts", "group_html", "half_unit", "in_seed_range",
     "in_widened_interval", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
     "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from pathlib import Path
 
 from safepg.learning import LearningRecord
@@ -42,8 +42,12 @@ def _records(exp: Experiment, root: Path | None, run: bool, jobs: int) -> dict[s
     return load_experiment(exp, root)
 
 
+#: The pages with rows measured on runs; the others' rows are all closed forms.
+RUN_PAGES = ("lqg1d", "lqg2d", "cartpole")
+
+
 def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mapping[str, Experiment] | None = None,
-              jobs: int = -1, book: Path | None = None) -> list[Row]:
+              jobs: int = -1, book: Path | None = None, pages: Collection[str] | None = None) -> list[Row]:
     """Every printed result of the thesis with ours, a status and a link.
 
     Parameters
@@ -64,12 +68,19 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     book : Path, optional
         The book's folder, whose headings give the links' anchors (default ``book/``
         beside the package).
+    pages : collection of str, optional
+        Only the rows linking to these pages (``"errata"``, ...). Without any page of
+        :data:`RUN_PAGES` no run is read: a theory chapter's counts cost no record loading.
 
     Returns
     -------
     list of Row
         Ordered by :data:`GROUPS`, then as in the thesis.
     """
+    if pages is not None and not set(pages) & set(RUN_PAGES):
+        b = Builder(book=book or BOOK)
+        closed_form_rows(b)
+        return _on_pages(b.rows, pages)
     overrides = dict(experiments or {})
     known = NEEDED + RANGE_VARIANTS + AUTHORS_VARIANTS
     unknown = set(overrides) - set(known)
@@ -90,4 +101,11 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     closed_form_rows(b)
     run_rows(b, exps, reps, recs, variant)
     order = {g: i for i, g in enumerate(GROUPS)}
-    return sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group
+    rows = sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group
+    return rows if pages is None else _on_pages(rows, pages)
+
+
+def _on_pages(rows: list[Row], pages: Collection[str]) -> list[Row]:
+    order = {g: i for i, g in enumerate(GROUPS)}
+    keep = [r for r in rows if r.link.split(".html", 1)[0] in set(pages)]
+    return sorted(keep, key=lambda r: order[r.group])

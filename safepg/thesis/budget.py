@@ -1,0 +1,180 @@
+"""The campaign's time budget: what each chapter computes, the random numbers and simulated
+steps it takes, the time it took, and how that compares with the random-number floor.
+
+The floor of a piece of work is the time this machine's fastest generator needs to draw its
+random numbers alone (the normals of the actions and the uniforms of the initial states),
+on every core. No simulation can beat it by much: a step costs a few multiplies, a normal
+about as many. benchmarks/bench_book.py measures the generators and builds the book from
+empty; this module reads, from the results store the build filled, what was computed and
+how long it took (``timing.jsonl`` of :func:`safepg.runner.record_timing`, the ``seconds``
+of the Table 5.1 sweep and of the safety measurements).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from safepg.envs.cartpole import CartPole
+from safepg.runner import RESULTS_VERSION, TIMING_FILE
+from safepg.thesis.cartpole_sweep import baseline_experiments
+from safepg.thesis.experiments import experiment_folder, get_experiment, load_experiment, make_env
+
+#: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
+CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
+    "lqg1d": ("table-5.1", "table-5.1-printed-theta0", "table-5.1-no-baseline", "table-5.2",
+              "table-5.2-lemma-range", "table-5.2-raw-score", "table-5.1-authors"),
+    "lqg2d": ("figures-5.5-5.6", "table-5.3", "table-5.3-authors"),
+    "cartpole": tuple(dict.fromkeys(("cartpole-baseline", "table-5.4", "cartpole-baseline-authors", "table-5.4-authors",
+                                     "table-5.4-authors-theta-star", *baseline_experiments(), "cartpole-sweep"))),
+}
+#: Stored computations that are not experiments: (folder, chapter).
+TABLE_51_SWEEP = "table-5.1-sweep"
+SAFETY_MC = "safety-mc"
+
+
+@dataclass(frozen=True)
+class Work:
+    """One stored computation: its counts and the wall time it took.
+
+    ``normals`` and ``uniforms`` are the random numbers the work needs (a kernel that replays
+    a trajectory draws its numbers again; that is counted in the time, not here); ``None``
+    where they are not known (the safety measurement stores no episode lengths).
+    """
+
+    name: str
+    chapter: str
+    trajectories: int
+    steps: int | None
+    normals: int | None
+    uniforms: int | None
+    seconds: float | None
+
+    def floor(self, normal_rate: float, uniform_rate: float) -> float | None:
+        """Seconds to draw the work's random numbers at the given rates (numbers per second)."""
+        if self.normals is None or self.uniforms is None:
+            return None
+        return self.normals / normal_rate + self.uniforms / uniform_rate
+
+
+def _timing_seconds(folder: Path) -> float | None:
+    """Total seconds of the computing calls recorded in ``folder/timing.jsonl`` (this version's)."""
+    path = folder / TIMING_FILE
+    if not path.exists():
+        return None
+    lines = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    lines = [d for d in lines if d.get("results_version") == RESULTS_VERSION]
+    return sum(d["seconds"] for d in lines) if lines else None
+
+
+def experiment_work(name: str, chapter: str, root: Path) -> Work:
+    """The counts of experiment ``name`` from its stored records, and its recorded time.
+
+    LQG: H steps of m normals per trajectory, m uniforms for the initial state. Cart-pole: one
+    normal per step it lived (the record's batch averages of the episode length give the
+    steps), four uniforms per trajectory.
+    """
+    exp = get_experiment(name)
+    recs = load_experiment(exp, root)
+    traj = steps = normals = uniforms = 0
+    for cfg in exp.configs:
+        env = make_env(cfg.env)
+        for rec in recs.get(cfg.name, []):
+            n = int(rec.batch_size.sum())
+            traj += n
+            if isinstance(env, CartPole):
+                lived = int(round(float(np.dot(rec.batch_size.astype(float), rec.J_hat))))
+                steps += lived
+                normals += lived
+                uniforms += 4 * n
+            else:
+                steps += n * env.horizon
+                normals += n * env.horizon * env.dim
+                uniforms += n * env.dim
+    return Work(name, chapter, traj, steps, normals, uniforms, _timing_seconds(experiment_folder(exp, root)))
+
+
+def sweep_work(root: Path) -> Work | None:
+    """The stored Table 5.1 sweeps (1-D LQG, H = 20): trajectories and seconds."""
+    files = sorted((root / TABLE_51_SWEEP).glob("*.json"))
+    if not files:
+        return None
+    data = [json.loads(p.read_text()) for p in files]
+    traj = sum(d.get("trajectories", 0) for d in data)
+    seconds = [d["seconds"] for d in data if "seconds" in d]
+    return Work(TABLE_51_SWEEP, "lqg1d", traj, 20 * traj, 20 * traj, traj, sum(seconds) if seconds else None)
+
+
+def safety_work(root: Path) -> list[Work]:
+    """The stored safety measurements by chapter (rollouts and seconds; random numbers not known)."""
+    by_chapter: dict[str, list[dict[str, Any]]] = {}
+    for p in sorted((root / SAFETY_MC).glob("*.json")):
+        d = json.loads(p.read_text())
+        chapter = "cartpole" if json.loads(d["key"])[0].startswith("CartPole") else "lqg2d"
+        by_chapter.setdefault(chapter, []).append(d)
+    out = []
+    for chapter, ds in by_chapter.items():
+        rollouts = sum(2 * sum(d["outcomes"]["rollouts"]) for d in ds)
+        seconds = [d["seconds"] for d in ds if "seconds" in d]
+        out.append(Work(SAFETY_MC, chapter, rollouts, None, None, None, sum(seconds) if seconds else None))
+    return out
+
+
+def campaign(root: Path) -> list[Work]:
+    """Every stored computation of the book's campaign, chapter by chapter."""
+    out = [experiment_work(n, ch, root) for ch, names in CHAPTER_EXPERIMENTS.items() for n in names]
+    sweep = sweep_work(root)
+    return out + ([sweep] if sweep else []) + safety_work(root)
+
+
+def budget_rows(works: list[Work], normal_rate: float, uniform_rate: float,
+                chapter_seconds: Mapping[str, float] | None = None) -> dict[str, list[dict[str, Any]]]:
+    """Per experiment and per chapter: counts, floor, measured seconds and their ratio.
+
+    A chapter's ``campaign_s`` is the sum of its computations' recorded times and its floor
+    that of the computations whose random numbers are known, so its ratio errs high.
+    ``chapter_seconds`` (the notebooks' execution times) adds each chapter's ``notebook_s``.
+    """
+    def ratio(measured: float | None, floor: float | None) -> float | None:
+        return None if measured is None or not floor else round(measured / floor, 2)
+
+    rows = []
+    for w in works:
+        floor = w.floor(normal_rate, uniform_rate)
+        rows.append({**asdict(w), "floor_s": None if floor is None else round(floor, 2),
+                     "ratio": ratio(w.seconds, floor)})
+    chapters = []
+    for ch in dict.fromkeys(w.chapter for w in works):
+        mine = [r for r in rows if r["chapter"] == ch]
+        floor = sum(r["floor_s"] or 0.0 for r in mine)
+        measured = sum(r["seconds"] or 0.0 for r in mine)
+        chapters.append({"chapter": ch, "trajectories": sum(r["trajectories"] for r in mine),
+                         "steps": sum(r["steps"] or 0 for r in mine), "normals": sum(r["normals"] or 0 for r in mine),
+                         "uniforms": sum(r["uniforms"] or 0 for r in mine), "floor_s": round(floor, 1),
+                         "campaign_s": round(measured, 1), "ratio": ratio(measured, floor),
+                         **({"notebook_s": chapter_seconds.get(ch)} if chapter_seconds else {})})
+    return {"experiments": rows, "chapters": chapters}
+
+
+def markdown(budget: Mapping[str, list[dict[str, Any]]]) -> str:
+    """The per-chapter and per-experiment tables of :func:`budget_rows`, in Markdown."""
+    def num(x: Any, fmt: str) -> str:
+        return "—" if x is None else format(x, fmt)
+
+    lines = ["| chapter | trajectories | steps | normals | floor (s) | campaign (s) | ratio | notebook (s) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for c in budget["chapters"]:
+        lines.append(f"| {c['chapter']} | {c['trajectories']:.3g} | {c['steps']:.3g} | {c['normals']:.3g} | "
+                     f"{c['floor_s']:.1f} | {c['campaign_s']:.1f} | {num(c['ratio'], '.2f')} | "
+                     f"{num(c.get('notebook_s'), '.1f')} |")
+    lines += ["", "| experiment | chapter | trajectories | normals | floor (s) | measured (s) | ratio |",
+              "|---|---|---:|---:|---:|---:|---:|"]
+    for r in budget["experiments"]:
+        lines.append(f"| {r['name']} | {r['chapter']} | {r['trajectories']:.3g} | {num(r['normals'], '.3g')} | "
+                     f"{num(r['floor_s'], '.2f')} | {num(r['seconds'], '.1f')} | {num(r['ratio'], '.2f')} |")
+    return "\n".join(lines) + "\n"
