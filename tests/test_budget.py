@@ -1,0 +1,80 @@
+"""The campaign's budget: counts from the store, recorded times, floor and ratio."""
+
+from __future__ import annotations
+
+import ast
+import json
+from pathlib import Path
+
+import pytest
+
+from safepg.runner import TIMING_FILE
+from safepg.thesis import budget
+from safepg.thesis.experiments import experiment_folder, get_experiment, run_experiment, scaled
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    root = tmp_path_factory.mktemp("store")
+    lqg = scaled(get_experiment("table-5.3"), seeds=2, budget=3000)
+    cart = scaled(get_experiment("cartpole-baseline"), seeds=1, budget=8000)
+    for exp in (lqg, cart):
+        run_experiment(exp, root=root, jobs=1, progress=False)
+    return root, lqg, cart
+
+
+def test_lqg_counts_follow_from_the_configs(store, monkeypatch):
+    root, lqg, _ = store
+    monkeypatch.setattr(budget, "get_experiment", lambda name: lqg)
+    w = budget.experiment_work("table-5.3", "lqg2d", root)
+    traj = len(lqg.configs) * lqg.seeds * 3000  # every run uses its whole budget
+    assert (w.trajectories, w.steps, w.normals, w.uniforms) == (traj, 20 * traj, 2 * 20 * traj, 2 * traj)
+    lines = (experiment_folder(lqg, root) / TIMING_FILE).read_text().splitlines()
+    assert len(lines) == 1 and json.loads(lines[0])["runs"] == len(lqg.configs) * lqg.seeds
+    assert w.seconds == pytest.approx(json.loads(lines[0])["seconds"]) and w.seconds > 0
+    run_experiment(lqg, root=root, jobs=1, progress=False)  # nothing left to compute: no new line
+    assert len((experiment_folder(lqg, root) / TIMING_FILE).read_text().splitlines()) == 1
+
+
+def test_cartpole_counts_one_normal_per_lived_step(store, monkeypatch):
+    root, _, cart = store
+    monkeypatch.setattr(budget, "get_experiment", lambda name: cart)
+    w = budget.experiment_work("cartpole-baseline", "cartpole", root)
+    rec = run_experiment(cart, root=root, jobs=1, progress=False)[cart.configs[0].name][0]
+    traj = int(rec.batch_size.sum())
+    assert w.trajectories == traj and w.uniforms == 4 * traj
+    assert traj <= w.steps <= 1000 * traj and w.normals == w.steps
+
+
+def test_rows_floor_and_ratio() -> None:
+    works = [budget.Work("a", "lqg1d", 10, 200, 200, 10, 4.0), budget.Work("b", "lqg1d", 5, 100, 100, 5, None),
+             budget.Work("safety-mc", "cartpole", 8, None, None, None, 3.0)]
+    out = budget.budget_rows(works, normal_rate=100.0, uniform_rate=10.0, chapter_seconds={"lqg1d": 9.0})
+    a, b, mc = out["experiments"]
+    assert a["floor_s"] == pytest.approx(200 / 100 + 10 / 10) and a["ratio"] == pytest.approx(4.0 / 3.0, abs=0.01)
+    assert b["ratio"] is None and mc["floor_s"] is None and mc["ratio"] is None
+    lqg1d, cartpole = out["chapters"]
+    assert lqg1d["floor_s"] == pytest.approx(3.0 + 1.5) and lqg1d["campaign_s"] == 4.0 and lqg1d["notebook_s"] == 9.0
+    assert cartpole["ratio"] is None  # nothing with known random numbers: no floor
+    table = budget.markdown(out)
+    assert "| lqg1d | 15 |" in table and "| safety-mc | cartpole |" in table
+
+
+def _notebook_names(chapter: str) -> list[str]:
+    """The experiment names of the chapter's ``names = [...]`` cell."""
+    cells = json.loads((ROOT / "book" / f"{chapter}.ipynb").read_text())["cells"]
+    for c in cells:
+        for node in ast.walk(ast.parse("".join(c["source"]))) if c["cell_type"] == "code" else ():
+            if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", None) == "names":
+                return list(ast.literal_eval(node.value))
+    raise AssertionError(f"no names = [...] cell in {chapter}")
+
+
+@pytest.mark.parametrize("chapter", list(budget.CHAPTER_EXPERIMENTS))
+def test_chapters_list_what_their_notebooks_run(chapter: str) -> None:
+    names = _notebook_names(chapter)
+    assert set(names) <= set(budget.CHAPTER_EXPERIMENTS[chapter])
+    for name in budget.CHAPTER_EXPERIMENTS[chapter]:
+        get_experiment(name)  # every listed name is an experiment
