@@ -233,3 +233,17 @@ def test_batch_maxima_are_the_largest_reward_and_feature(case: str) -> None:
     pol_scaled = LinearGaussianPolicy(K * np.asarray(NORMALISED_SCALE), sig)  # the same policy in those units
     assert scaled.gradient_batch_maxima(pol_scaled, 300, 5)[2][1] == pytest.approx(
         _reference_peak(scaled, pol_scaled, 300, 5), rel=1e-12)
+
+
+@pytest.mark.parametrize("score_clipped", [True, False])
+def test_kept_scores_and_replay_give_the_same_bits(score_clipped: bool) -> None:
+    """Pass 2 from the cumulative scores pass 1 kept, or from simulating again: identical."""
+    task, K, sig = CASES["mixed"]
+    args = (sig, task.pole_length, task.cart_mass, task.pole_mass, task.gravity, task.tau)
+    tail = (task.gamma, task.action_bound, task.x_threshold, task.angle_threshold, score_clipped, False, True)
+    key = batch_key(np.random.default_rng(11))
+    n = 3 * CHUNK + 5
+    kept = cartpole_gradient_samples(K, *args, key, n, task.horizon, task.init_bound, *tail)
+    replay = cartpole_gradient_samples(K, *args, key, n, task.horizon, task.init_bound, *tail, history_steps=0)
+    assert np.array_equal(kept[0], replay[0]) and np.array_equal(kept[1], replay[1])
+    assert np.any(kept[1] < task.horizon) and np.any(kept[1] == task.horizon)  # both endings occur

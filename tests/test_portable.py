@@ -318,3 +318,14 @@ def test_runs_are_bit_identical_across_cpu_settings(tmp_path: Path) -> None:
     for name in host:
         assert generic[name] == host[name], f"{name} differs with NUMBA_CPU_NAME=generic"
         assert old_cpu[name] == host[name], f"{name} differs with a pre-AVX2 libm and NumPy"
+
+
+def test_small_angles_skip_the_reduction_with_the_same_bits() -> None:
+    """Below 0.78 the fast path returns what the full reduction (k = 0, r = x) gives."""
+    x = np.random.default_rng(3).uniform(-0.78, 0.78, 50_000)
+    x[:4] = [0.0, -0.0, 0.7799999999999999, -0.7799999999999999]
+    for v in x[:2000].tolist() + [0.7799999999999999]:
+        r, q = portable._reduce(v)
+        assert q == 0 and r == v
+    assert portable.sin_array(x).tolist() == [portable._sin_poly(v) for v in x.tolist()]
+    assert portable.cos_array(x).tolist() == [portable._cos_poly(v) for v in x.tolist()]

@@ -17,8 +17,9 @@ Two things need care when the time loop stops early:
   the final :math:`G^2` of trajectories that ended at step T, and the denominators get
   their running sum over T <= l.
 - Pass 2 subtracts :math:`\sum_l G_{n,l} b_l`; the dead steps contribute
-  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps are recomputed by
-  simulating the trajectory again from the start of its stream (the same numbers, the same
+  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps' G come from pass 1,
+  which keeps them when the batch is small enough (:data:`HISTORY_STEPS`); a bigger batch
+  simulates each trajectory again from the start of its stream (the same numbers, the same
   code, so the same bits) instead of keeping an (N, H, 4) array of cumulative scores.
 
 As in :mod:`safepg.envs._lqg_kernel`, trajectories are processed in fixed-size chunks in
@@ -38,6 +39,8 @@ from safepg.streams import next_normal, next_uniform, stream_start
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
 #: spreads over a few threads, large enough that the per-chunk (H, 4) sums stay small.
 CHUNK = 512
+#: Largest N * H whose cumulative scores pass 1 keeps for pass 2 (8 * 10^6: 256 MB at most).
+HISTORY_STEPS = 8_000_000
 
 
 @njit(cache=True)
@@ -88,38 +91,66 @@ def _initial_state(key, n, init_bound):
 
 @njit(cache=True)
 def _first_pass(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, gamma, action_bound, x_threshold,
-                angle_threshold,
-                score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended, kept,
-                semi_implicit, peak):
+                angle_threshold, score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended,
+                kept, semi_implicit, peak, history):
     """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
     lengths, their largest |state component| (``peak``, the initial and the final state
-    included), and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4)."""
+    included), and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4).
+
+    Time runs in the outer loop and the chunk's live trajectories in the inner one: a step of
+    one trajectory waits on its previous step (sine, cosine, two divisions), and stepping the
+    others in between keeps the CPU busy meanwhile. Every trajectory's operations are those
+    of following it alone, and every sum over trajectories is formed in the order of their
+    indices, as before: the same bits.
+
+    ``history`` (N * H, 4), unless it has a single row: the cumulative scores G of trajectory
+    n at step t go to row n * H + t, for :func:`_second_pass_stored`.
+    """
     half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
-    for n in range(lo, hi):
-        x, x_dot, beta, beta_dot, state = _initial_state(key, n, init_bound)
-        p0, p1, p2, p3 = abs(x), abs(x_dot), abs(beta), abs(beta_dot)
-        g0 = g1 = g2 = g3 = 0.0  # cumulative scores
-        a0 = a1 = a2 = a3 = 0.0  # G(PO)MDP sample without baseline
-        disc = 1.0
-        ret = 0.0
-        T = H
-        for t in range(H):
+    m = hi - lo
+    store = history.shape[0] > 1
+    st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
+    s = np.empty((m, 4))  # x, x_dot, beta, beta_dot
+    g = np.zeros((m, 4))  # cumulative scores
+    a = np.zeros((m, 4))  # G(PO)MDP sample without baseline
+    pk = np.empty((m, 4))
+    ret = np.zeros(m)
+    T = np.full(m, H)
+    live = np.empty(m, dtype=np.intp)  # indices of the live trajectories, in increasing order
+    for i in range(m):
+        s[i, 0], s[i, 1], s[i, 2], s[i, 3], st[i] = _initial_state(key, lo + i, init_bound)
+        for p in range(4):
+            pk[i, p] = abs(s[i, p])
+        live[i] = i
+    n_live = m
+    disc = 1.0
+    for t in range(H):
+        if n_live == 0:
+            break
+        kept_live = 0
+        for j in range(n_live):
+            i = live[j]
+            x, x_dot, beta, beta_dot = s[i, 0], s[i, 1], s[i, 2], s[i, 3]
             mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            zt, state = next_normal(state)
+            zt, st[i] = next_normal(st[i])
             a_raw = mean + sigma * zt
             u = min(max(a_raw, -action_bound), action_bound)
             d = ((u if score_clipped else a_raw) - mean) * inv_var
-            g0 += d * x
-            g1 += d * x_dot
-            g2 += d * beta
-            g3 += d * beta_dot
-            ret += disc  # reward 1: alive at t (the step into a failing state counts)
+            g0 = g[i, 0] + d * x
+            g1 = g[i, 1] + d * x_dot
+            g2 = g[i, 2] + d * beta
+            g3 = g[i, 3] + d * beta_dot
+            g[i, 0], g[i, 1], g[i, 2], g[i, 3] = g0, g1, g2, g3
+            if store:
+                row = (lo + i) * H + t
+                history[row, 0], history[row, 1], history[row, 2], history[row, 3] = g0, g1, g2, g3
+            ret[i] += disc  # reward 1: alive at t (the step into a failing state counts)
             if not reinforce_estimator:
-                a0 += g0 * disc
-                a1 += g1 * disc
-                a2 += g2 * disc
-                a3 += g3 * disc
+                a[i, 0] += g0 * disc
+                a[i, 1] += g1 * disc
+                a[i, 2] += g2 * disc
+                a[i, 3] += g3 * disc
                 if baseline:
                     num[t, 0] += g0 * g0 * disc
                     num[t, 1] += g1 * g1 * disc
@@ -129,73 +160,126 @@ def _first_pass(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, gamma, ac
                     den[t, 1] += g1 * g1
                     den[t, 2] += g2 * g2
                     den[t, 3] += g3 * g3
-            disc *= gamma
             x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass, gravity, tau,
                                              semi_implicit)
-            p0, p1, p2, p3 = max(p0, abs(x)), max(p1, abs(x_dot)), max(p2, abs(beta)), max(p3, abs(beta_dot))
+            s[i, 0], s[i, 1], s[i, 2], s[i, 3] = x, x_dot, beta, beta_dot
+            pk[i, 0] = max(pk[i, 0], abs(x))
+            pk[i, 1] = max(pk[i, 1], abs(x_dot))
+            pk[i, 2] = max(pk[i, 2], abs(beta))
+            pk[i, 3] = max(pk[i, 3], abs(beta_dot))
             # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
             if not (abs(x) <= x_threshold and abs(beta) <= angle_threshold):
-                T = t + 1
-                break
-        lengths[n] = T
-        peak[n, 0], peak[n, 1], peak[n, 2], peak[n, 3] = p0, p1, p2, p3
+                T[i] = t + 1
+            else:
+                live[kept_live] = i  # compacted in place, order kept
+                kept_live += 1
+        n_live = kept_live
+        disc *= gamma
+    for i in range(m):
+        n = lo + i
+        lengths[n] = T[i]
+        for p in range(4):
+            peak[n, p] = pk[i, p]
+        g0, g1, g2, g3 = g[i, 0], g[i, 1], g[i, 2], g[i, 3]
         if reinforce_estimator:
-            samples[n, 0] = g0 * ret
-            samples[n, 1] = g1 * ret
-            samples[n, 2] = g2 * ret
-            samples[n, 3] = g3 * ret
+            r = ret[i]
+            samples[n, 0] = g0 * r
+            samples[n, 1] = g1 * r
+            samples[n, 2] = g2 * r
+            samples[n, 3] = g3 * r
             if baseline:
-                num[0, 0] += g0 * g0 * ret
-                num[0, 1] += g1 * g1 * ret
-                num[0, 2] += g2 * g2 * ret
-                num[0, 3] += g3 * g3 * ret
+                num[0, 0] += g0 * g0 * r
+                num[0, 1] += g1 * g1 * r
+                num[0, 2] += g2 * g2 * r
+                num[0, 3] += g3 * g3 * r
                 den[0, 0] += g0 * g0
                 den[0, 1] += g1 * g1
                 den[0, 2] += g2 * g2
                 den[0, 3] += g3 * g3
                 kept[n, 0], kept[n, 1], kept[n, 2], kept[n, 3] = g0, g1, g2, g3
         else:
-            samples[n, 0], samples[n, 1], samples[n, 2], samples[n, 3] = a0, a1, a2, a3
-            if baseline and T < H:
-                ended[T, 0] += g0 * g0
-                ended[T, 1] += g1 * g1
-                ended[T, 2] += g2 * g2
-                ended[T, 3] += g3 * g3
+            samples[n, 0], samples[n, 1], samples[n, 2], samples[n, 3] = a[i, 0], a[i, 1], a[i, 2], a[i, 3]
+            if baseline and T[i] < H:
+                ended[T[i], 0] += g0 * g0
+                ended[T[i], 1] += g1 * g1
+                ended[T[i], 2] += g2 * g2
+                ended[T[i], 3] += g3 * g3
 
 
 @njit(cache=True)
 def _second_pass(lo, hi, K, sigma, inv_var, consts, key, init_bound, action_bound, score_clipped, b, suffix,
                  samples, lengths, semi_implicit):
-    """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again."""
+    """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again
+    (time outside, trajectories inside, as in :func:`_first_pass`)."""
     half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
-    for n in range(lo, hi):
-        x, x_dot, beta, beta_dot, state = _initial_state(key, n, init_bound)
-        g0 = g1 = g2 = g3 = 0.0
-        a0 = a1 = a2 = a3 = 0.0  # sum_l G_l b_l over the live steps
-        T = int(lengths[n])
-        # Pass 1's trajectory again, operation for operation: it ends at T, no need to test.
-        for t in range(T):
+    m = hi - lo
+    st = np.empty(m, dtype=np.uint64)
+    s = np.empty((m, 4))
+    g = np.zeros((m, 4))
+    a = np.zeros((m, 4))  # sum_l G_l b_l over the live steps
+    T = np.empty(m, dtype=np.intp)
+    live = np.empty(m, dtype=np.intp)
+    H = 0
+    for i in range(m):
+        s[i, 0], s[i, 1], s[i, 2], s[i, 3], st[i] = _initial_state(key, lo + i, init_bound)
+        T[i] = int(lengths[lo + i])
+        H = max(H, T[i])
+        live[i] = i
+    n_live = m
+    # Pass 1's trajectories again, operation for operation: each ends at its T, no need to test.
+    for t in range(H):
+        kept_live = 0
+        for j in range(n_live):
+            i = live[j]
+            x, x_dot, beta, beta_dot = s[i, 0], s[i, 1], s[i, 2], s[i, 3]
             mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            zt, state = next_normal(state)
+            zt, st[i] = next_normal(st[i])
             a_raw = mean + sigma * zt
             u = min(max(a_raw, -action_bound), action_bound)
             d = ((u if score_clipped else a_raw) - mean) * inv_var
-            g0 += d * x
-            g1 += d * x_dot
-            g2 += d * beta
-            g3 += d * beta_dot
-            a0 += g0 * b[t, 0]
-            a1 += g1 * b[t, 1]
-            a2 += g2 * b[t, 2]
-            a3 += g3 * b[t, 3]
-            if t + 1 < T:  # the state after the last step is never used
+            g0 = g[i, 0] + d * x
+            g1 = g[i, 1] + d * x_dot
+            g2 = g[i, 2] + d * beta
+            g3 = g[i, 3] + d * beta_dot
+            g[i, 0], g[i, 1], g[i, 2], g[i, 3] = g0, g1, g2, g3
+            a[i, 0] += g0 * b[t, 0]
+            a[i, 1] += g1 * b[t, 1]
+            a[i, 2] += g2 * b[t, 2]
+            a[i, 3] += g3 * b[t, 3]
+            if t + 1 < T[i]:  # the state after the last step is never used
                 x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass,
                                                  gravity, tau, semi_implicit)
-        samples[n, 0] -= a0 + g0 * suffix[T, 0]
-        samples[n, 1] -= a1 + g1 * suffix[T, 1]
-        samples[n, 2] -= a2 + g2 * suffix[T, 2]
-        samples[n, 3] -= a3 + g3 * suffix[T, 3]
+                s[i, 0], s[i, 1], s[i, 2], s[i, 3] = x, x_dot, beta, beta_dot
+                live[kept_live] = i
+                kept_live += 1
+        n_live = kept_live
+    for i in range(m):
+        n, Ti = lo + i, T[i]
+        samples[n, 0] -= a[i, 0] + g[i, 0] * suffix[Ti, 0]
+        samples[n, 1] -= a[i, 1] + g[i, 1] * suffix[Ti, 1]
+        samples[n, 2] -= a[i, 2] + g[i, 2] * suffix[Ti, 2]
+        samples[n, 3] -= a[i, 3] + g[i, 3] * suffix[Ti, 3]
+
+
+@njit(cache=True)
+def _second_pass_stored(lo, hi, H, history, b, suffix, samples, lengths):
+    """:func:`_second_pass` from the cumulative scores pass 1 stored: the same terms added in
+    the same order, so the same bits, without simulating again."""
+    for n in range(lo, hi):
+        T = int(lengths[n])
+        a0 = a1 = a2 = a3 = 0.0
+        for t in range(T):
+            row = n * H + t
+            a0 += history[row, 0] * b[t, 0]
+            a1 += history[row, 1] * b[t, 1]
+            a2 += history[row, 2] * b[t, 2]
+            a3 += history[row, 3] * b[t, 3]
+        last = n * H + T - 1
+        samples[n, 0] -= a0 + history[last, 0] * suffix[T, 0]
+        samples[n, 1] -= a1 + history[last, 1] * suffix[T, 1]
+        samples[n, 2] -= a2 + history[last, 2] * suffix[T, 2]
+        samples[n, 3] -= a3 + history[last, 3] * suffix[T, 3]
 
 
 @njit(cache=True)
@@ -244,7 +328,7 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                               x_threshold: float, angle_threshold: float,
                               score_clipped: bool, reinforce_estimator: bool,
                               baseline: bool, semi_implicit: bool = False, polemass_length: float | None = None,
-                              peaks: bool = False) -> tuple[np.ndarray, ...]:
+                              peaks: bool = False, history_steps: int = HISTORY_STEPS) -> tuple[np.ndarray, ...]:
     """Per-trajectory REINFORCE or G(PO)MDP samples (N, 4) and episode lengths (N,).
 
     Parameters
@@ -277,6 +361,9 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         :func:`safepg.envs.cartpole.step_dynamics`).
     peaks : bool
         Also return each trajectory's largest |state component|.
+    history_steps : int
+        G(PO)MDP with baseline: the largest N * H whose cumulative scores pass 1 keeps for
+        pass 2; above it pass 2 simulates again (the same bits either way).
 
     Returns
     -------
@@ -302,13 +389,13 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                                     float(tau), np.uint64(key), int(n), int(horizon), float(init_bound),
                                     float(gamma), float(action_bound), float(x_threshold),
                                     float(angle_threshold), bool(score_clipped), bool(reinforce_estimator),
-                                    bool(baseline), bool(semi_implicit))
+                                    bool(baseline), bool(semi_implicit), int(history_steps))
     return (samples, lengths, peak) if peaks else (samples, lengths)
 
 
 @njit(cache=True, parallel=True)
 def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, init_bound, gamma, action_bound,
-           x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
+           x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit, history_steps):
     """:func:`cartpole_gradient_samples` on normalised arguments."""
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.zeros((N, 4))
@@ -322,6 +409,10 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
     ended = np.zeros((n_chunks if gpomdp_baseline else 1, H + 1, 4))
     # REINFORCE's baseline needs only the total score S_n, not a second simulation.
     kept = np.empty((N if baseline and reinforce_estimator else 1, 4))
+    # G(PO)MDP's cumulative scores, kept for pass 2 up to history_steps trajectory-steps (32
+    # bytes each; only the steps lived are written); a bigger batch simulates pass 2 again.
+    store = gpomdp_baseline and N * H <= history_steps
+    history = np.empty((N * H if store else 1, 4))
     inv_var = 1.0 / (sigma * sigma)
     consts = (half, ml, cart_mass + pole_mass, pole_mass, gravity, tau)
     # Without a baseline the sums are never touched: every chunk gets the same dummy row.
@@ -332,7 +423,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
         j = c * j_step
         _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, gamma,
                     action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
-                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit, peak)
+                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit, peak, history)
     if not baseline:
         return samples, lengths, peak
 
@@ -344,6 +435,9 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
         return samples, lengths, peak
 
     for c in prange(n_chunks):
-        _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, init_bound, action_bound,
-                     score_clipped, b, suffix, samples, lengths, semi_implicit)
+        if store:
+            _second_pass_stored(c * CHUNK, min(N, (c + 1) * CHUNK), H, history, b, suffix, samples, lengths)
+        else:
+            _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, init_bound,
+                         action_bound, score_clipped, b, suffix, samples, lengths, semi_implicit)
     return samples, lengths, peak

@@ -485,8 +485,8 @@ class CartPole:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Gradient samples and undiscounted returns of a fresh batch, fused.
 
-        The same random numbers, drawn in the same order, as :meth:`simulate` (the (n, 4)
-        initial states, then (n, H, 1) standard normals), and the same numbers as
+        The same random numbers as :meth:`simulate` (one batch key from ``rng``; trajectory i
+        reads stream i: its initial state, then a standard normal per step), and the same numbers as
         ``gradient_samples(policy, simulate(...), estimator, baseline, score_action)`` and
         ``undiscounted_returns(simulate(...))`` up to rounding, without materialising the
         trajectories: each episode is followed only until it terminates (see

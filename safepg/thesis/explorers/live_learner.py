@@ -12,7 +12,7 @@ The Python twin ``compute_py`` runs :func:`safepg.learning.adaptive_pg` and
 :func:`~safepg.learning.vanilla_pg` with the same settings and returns the same structure
 (:meth:`LiveLearnerExplorer.interactive` draws it with ipywidgets, in a worker thread that
 shows each run's progress and stops a run when a control moves). The two use different
-random-number generators (numpy's PCG64 here, xoshiro128** in the page), so for one seed
+random-number generators (safepg's counter-based streams here, xoshiro128** in the page), so for one seed
 their curves differ as two seeds do; tests/test_learner_js.py shows that they agree in
 distribution.
 
