@@ -29,10 +29,12 @@ so the result does not depend on the number of threads.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import njit, prange
 
 from safepg import portable
+from safepg.envs._lqg_kernel import serial
 from safepg.streams import next_normal, next_uniform, stream_start
 
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
@@ -385,7 +387,8 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
     half = 0.5 * float(pole_length)
     # pole_mass * half is the product the consistent equations form first: the same bits.
     ml = float(pole_mass) * half if polemass_length is None else float(polemass_length)
-    samples, lengths, peak = _fused(K, float(sigma), half, ml, float(cart_mass), float(pole_mass), float(gravity),
+    fused = _fused_serial if n <= CHUNK or numba.get_num_threads() == 1 else _fused  # the same numbers
+    samples, lengths, peak = fused(K, float(sigma), half, ml, float(cart_mass), float(pole_mass), float(gravity),
                                     float(tau), np.uint64(key), int(n), int(horizon), float(init_bound),
                                     float(gamma), float(action_bound), float(x_threshold),
                                     float(angle_threshold), bool(score_clipped), bool(reinforce_estimator),
@@ -441,3 +444,6 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
             _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, init_bound,
                          action_bound, score_clipped, b, suffix, samples, lengths, semi_implicit)
     return samples, lengths, peak
+
+
+_fused_serial = serial(_fused)

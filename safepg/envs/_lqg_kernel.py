@@ -15,6 +15,8 @@ number of threads.
 
 from __future__ import annotations
 
+import types
+
 import numpy as np
 from numba import njit, prange
 
@@ -388,3 +390,19 @@ def lqg_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip, s
                         acc += kept[n, t, p] * b[t, p]
                     samples[n, p] -= acc
     return samples, returns
+
+
+def serial(kernel):
+    """The same kernel compiled without threads (``prange`` runs as ``range``): the same chunks
+    in the same order, so the same bits, without the thread pool's start-up of a few
+    microseconds per call, which a one-thread worker at N = 100 pays on every batch."""
+    f = kernel.py_func
+    g = types.FunctionType(f.__code__, f.__globals__, f.__name__ + "_serial", f.__defaults__, f.__closure__)
+    g.__qualname__ = f.__qualname__ + "_serial"  # its own entry in numba's cache
+    g.__doc__ = f"Serial :func:`{f.__name__}`."
+    return njit(cache=True)(g)
+
+
+lqg1d_gradient_samples_serial = serial(lqg1d_gradient_samples)
+lqg2d_gradient_samples_serial = serial(lqg2d_gradient_samples)
+lqg_gradient_samples_serial = serial(lqg_gradient_samples)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from safepg import portable
@@ -332,7 +333,7 @@ class LQG:
         as ``gradient_samples(policy, simulate(...), ...)`` up to rounding, without
         materialising the trajectories (see :mod:`safepg.envs._lqg_kernel`).
         """
-        from safepg.envs._lqg_kernel import lqg1d_gradient_samples, lqg2d_gradient_samples, lqg_gradient_samples
+        from safepg.envs import _lqg_kernel as kernels
 
         self._check_policy(policy)
         if int(n) != n or n < 1:
@@ -344,10 +345,15 @@ class LQG:
         head = (batch_key(rng), int(n), int(self.horizon))
         flags = (float(self.gamma), float(self.state_bound), float(self.action_bound), bool(self.clip),
                  score_action == "clipped", estimator == "reinforce", bool(baseline))
+        # One chunk, or one thread (a campaign's worker): the serial build, the same numbers.
+        serial = n <= kernels.CHUNK or numba.get_num_threads() == 1
         if self.dim == 1:
-            return lqg1d_gradient_samples(
-                float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
-                float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
+            kernel = kernels.lqg1d_gradient_samples_serial if serial else kernels.lqg1d_gradient_samples
+            return kernel(float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
+                          float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
         # m = 2 (Section 5.2) has its own unrolled kernel; m >= 3 uses the generic loops.
-        kernel = lqg2d_gradient_samples if self.dim == 2 else lqg_gradient_samples
+        if self.dim == 2:
+            kernel = kernels.lqg2d_gradient_samples_serial if serial else kernels.lqg2d_gradient_samples
+        else:
+            kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
         return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
