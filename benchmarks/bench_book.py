@@ -141,7 +141,8 @@ def main() -> None:
 
         chapters = chapter_times(work)
         budget = budget_rows(campaign(work / "results"), normal_rate, uniform_rate, chapters)
-        out = {"date": time.strftime("%Y-%m-%d"), "machine": machine(), "build_wall_s": None if wall is None
+        out = {"date": time.strftime("%Y-%m-%d"), "cores": os.cpu_count(), "machine": machine(),
+               "build_wall_s": None if wall is None
                else round(wall, 1), "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
                "generators_per_s_all_cores": {k: {kk: float(f"{vv:.4g}") for kk, vv in v.items()}
                                               for k, v in rates.items()},

@@ -41,8 +41,9 @@ from safepg.streams import next_normal, next_uniform, stream_start
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
 #: spreads over a few threads, large enough that the per-chunk (H, 4) sums stay small.
 CHUNK = 512
-#: Largest N * H whose cumulative scores pass 1 keeps for pass 2 (8 * 10^6: 256 MB at most).
-HISTORY_STEPS = 8_000_000
+#: Largest N * H whose cumulative scores pass 1 keeps for pass 2 (2.4 * 10^7: 768 MB at most,
+#: N = 120000 at H = 200; the pages of steps not lived are never touched).
+HISTORY_STEPS = 24_000_000
 
 
 @njit(cache=True)
