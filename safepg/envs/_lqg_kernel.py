@@ -31,7 +31,11 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
     """Scalar (m = 1) version of :func:`lqg_gradient_samples`.
 
     Section 5.1's campaign is almost all scalar steps; with scalars in registers this
-    runs about twice as fast as the matrix loops below at m = 1.
+    runs about twice as fast as the matrix loops below at m = 1. Within a chunk, time runs
+    in the outer loop and the trajectories in the inner one, so that consecutive steps of
+    different trajectories overlap (about 13% faster than following one trajectory at a
+    time); every trajectory's operations and every sum's order over trajectories are those
+    of following them one by one: the same bits.
     """
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.empty((N, 1))
@@ -42,40 +46,49 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
     kept = np.empty((N if baseline else 1, rows))
     inv_var = 1.0 / (sigma * sigma)
     for c in prange(n_chunks):
-        for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-            state = stream_start(key, n)
-            u0, state = next_uniform(state)
-            s = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
-            cum = 0.0
-            acc = 0.0
-            disc = 1.0
-            ret = 0.0
-            for t in range(H):
-                mean = theta * s
-                zt, state = next_normal(state)
+        lo = c * CHUNK
+        m = min(N, lo + CHUNK) - lo
+        st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
+        s = np.empty(m)
+        cum = np.zeros(m)
+        acc = np.zeros(m)
+        ret = np.zeros(m)
+        for i in range(m):
+            state = stream_start(key, lo + i)
+            u0, st[i] = next_uniform(state)
+            s[i] = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
+        disc = 1.0
+        for t in range(H):
+            for i in range(m):
+                si = s[i]
+                mean = theta * si
+                zt, st[i] = next_normal(st[i])
                 a_raw = mean + sigma * zt
                 u = min(max(a_raw, -ba), ba) if clip else a_raw
-                dr = -0.5 * (Q * s * s + R * u * u) * disc
-                ret += dr
-                cum += ((u if score_clipped else a_raw) - mean) * s * inv_var
+                dr = -0.5 * (Q * si * si + R * u * u) * disc
+                ret[i] += dr
+                g = cum[i] + ((u if score_clipped else a_raw) - mean) * si * inv_var
+                cum[i] = g
                 if not reinforce_estimator:
-                    acc += cum * dr
-                    num[c, t] += cum * cum * dr
-                    den[c, t] += cum * cum
+                    acc[i] += g * dr
+                    num[c, t] += g * g * dr
+                    den[c, t] += g * g
                     if baseline:
-                        kept[n, t] = cum
-                disc *= gamma
-                s = A * s + B * u
-                if clip:
-                    s = min(max(s, -bs), bs)
-            returns[n] = ret
+                        kept[lo + i, t] = g
+                s_next = A * si + B * u
+                s[i] = min(max(s_next, -bs), bs) if clip else s_next
+            disc *= gamma
+        for i in range(m):
+            n = lo + i
+            returns[n] = ret[i]
             if reinforce_estimator:
-                num[c, 0] += cum * cum * ret
-                den[c, 0] += cum * cum
-                acc = cum * ret
+                g = cum[i]
+                num[c, 0] += g * g * ret[i]
+                den[c, 0] += g * g
+                acc[i] = g * ret[i]
                 if baseline:
-                    kept[n, 0] = cum
-            samples[n, 0] = acc
+                    kept[n, 0] = g
+            samples[n, 0] = acc[i]
     if baseline:
         b = _baseline(num, den)
         for c in prange(n_chunks):
