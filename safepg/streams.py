@@ -13,15 +13,15 @@ increments and mix is SplitMix64's output function (Steele, Lea & Flood, "Fast s
 pseudorandom number generators", OOPSLA 2014), which passes BigCrush on a Weyl sequence.
 A stream depends only on (key, n), not on which thread runs it or when, so a batch is
 the same for any thread count and any chunking, and a kernel can replay a trajectory's
-numbers (the cart-pole's second pass does) without storing them.
+numbers without storing them (the cart-pole's second pass does, for big batches).
 
 The key of every batch comes from the run's ``numpy.random.Generator``
 (:func:`batch_key`), so a run's seed still fixes every batch.
 
 Normals are drawn by the 256-layer ziggurat (Marsaglia & Tsang, "The ziggurat method for
-generating random variables", J. Stat. Softw. 5(8), 2000) on signed 53-bit integers, with
-the tables of NumPy's ``standard_normal``. Its tables are computed here with mpmath at 40 digits and
-rounded once, and the exponential of the wedge test and the logarithm of the tail use
+generating random variables", J. Stat. Softw. 5(8), 2000) on signed 53-bit integers, laid
+out as NumPy's ``standard_normal``. Its tables are computed here with mpmath at 40 digits
+and rounded once, and the exponential of the wedge test and the logarithm of the tail use
 :func:`safepg.portable.exp_kernel` and :func:`safepg.portable.log_kernel`: every draw is
 integer arithmetic and single IEEE operations, the same bits on every x86-64 CPU.
 """
@@ -37,7 +37,6 @@ _GAMMA_KEY = np.uint64(0x9E3779B97F4A7C15)  # 2^64 / golden ratio, odd
 _GAMMA_DRAW = np.uint64(0xD1B54A32D192ED03)  # another odd increment, unrelated to the first
 _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
-_MANTISSA = np.uint64((1 << 52) - 1)
 _TWO_M53 = 1.0 / 9007199254740992.0
 
 #: Right edge r of the ziggurat's base strip for 256 layers: the root, found with mpmath at
@@ -54,8 +53,8 @@ def _ziggurat_tables(dps: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     With :math:`f(x) = e^{-x^2/2}`, the base strip's area (rectangle plus tail) is
     :math:`v = r f(r) + \sqrt{\pi/2}\,\operatorname{erfc}(r/\sqrt2)` and the layer edges
     satisfy :math:`x_{i-1} = f^{-1}(f(x_i) + v/x_i)`, from :math:`x_{255} = r` down to
-    :math:`x_1`. A 52-bit integer j in layer i gives :math:`x = j w_i`, accepted at once
-    when :math:`j < k_i`, i.e. when x lies under the next layer up.
+    :math:`x_1`. A signed integer j (:math:`|j| < 2^{52}`) in layer i gives :math:`x = j w_i`,
+    accepted at once when :math:`|j| < k_i`, i.e. when x lies under the next layer up.
     """
     import mpmath
 

@@ -18,8 +18,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from safepg import portable
 from safepg.envs.cartpole import CartPole
 from safepg.runner import RESULTS_VERSION, TIMING_FILE
 from safepg.thesis.cartpole_sweep import baseline_experiments
@@ -88,7 +87,8 @@ def experiment_work(name: str, chapter: str, root: Path) -> Work:
             n = int(rec.batch_size.sum())
             traj += n
             if isinstance(env, CartPole):
-                lived = int(round(float(np.dot(rec.batch_size.astype(float), rec.J_hat))))
+                # Each batch's mean episode length times its size, summed exactly (no BLAS).
+                lived = round(portable.dot(rec.batch_size.astype(float), rec.J_hat))
                 steps += lived
                 normals += lived
                 uniforms += 4 * n
