@@ -213,7 +213,8 @@ def _reduce(x: float) -> tuple[float, int]:
 
 
 @njit(cache=True)
-def _sin_poly(r: float) -> float:
+def sin_poly(r: float) -> float:
+    """sin r for |r| <= pi/4 (no reduction, no branch): :func:`sin` below 0.78 rad."""
     r2 = r * r
     p = -1.0 / 51090942171709440000.0
     p = p * r2 + 1.0 / 121645100408832000.0
@@ -229,7 +230,8 @@ def _sin_poly(r: float) -> float:
 
 
 @njit(cache=True)
-def _cos_poly(r: float) -> float:
+def cos_poly(r: float) -> float:
+    """cos r for |r| <= pi/4 (no reduction, no branch): :func:`cos` below 0.78 rad."""
     r2 = r * r
     p = -1.0 / 1124000727777607680000.0
     p = p * r2 + 1.0 / 2432902008176640000.0
@@ -249,19 +251,19 @@ def _sin_quadrant(r: float, q: int) -> float:
     """sin(r + q pi/2) for |r| <= pi/4; cos x = sin(x + pi/2) is quadrant q + 1."""
     q = q & 3
     if q == 0:
-        return _sin_poly(r)
+        return sin_poly(r)
     if q == 1:
-        return _cos_poly(r)
+        return cos_poly(r)
     if q == 2:
-        return -_sin_poly(r)
-    return -_cos_poly(r)
+        return -sin_poly(r)
+    return -cos_poly(r)
 
 
 @njit(cache=True)
 def sin(x: float) -> float:
     """sin x with CPU-independent bits (|x| < 1e5; beyond that, libm's)."""
     if abs(x) < _NO_REDUCTION:  # k = 0: the reduction returns x itself, so this is the same value
-        return _sin_poly(x)
+        return sin_poly(x)
     if not abs(x) < 1e5:
         return math.sin(x)
     r, q = _reduce(x)
@@ -272,7 +274,7 @@ def sin(x: float) -> float:
 def cos(x: float) -> float:
     """cos x with CPU-independent bits (|x| < 1e5; beyond that, libm's)."""
     if abs(x) < _NO_REDUCTION:
-        return _cos_poly(x)
+        return cos_poly(x)
     if not abs(x) < 1e5:
         return math.cos(x)
     r, q = _reduce(x)

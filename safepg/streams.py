@@ -126,14 +126,34 @@ def next_normal(state: np.uint64) -> tuple[float, np.uint64]:
     test (:math:`f(x)` against a uniform height inside the layer) or, in the base strip,
     sample the tail beyond r by Marsaglia's exponential method (:func:`_normal_slow`).
     """
+    z, state, accepted = normal_candidate(state)
+    if accepted:
+        return z, state
+    return normal_redraw(state)
+
+
+@njit(cache=True)
+def normal_candidate(state: np.uint64) -> tuple[float, np.uint64, bool]:
+    """The ziggurat's first comparison alone: (candidate, new state, accepted).
+
+    Branch-free, so that a kernel can draw a whole array of streams in one vectorised loop
+    and call :func:`normal_redraw` for the few rejected ones; the two together are
+    :func:`next_normal`, the same bits.
+    """
     bits, state = next_uint64(state)
     idx = np.intp(bits & np.uint64(0xFF))
     # The top 53 bits as a signed integer j in [-2^52, 2^52): sign and abscissa at once,
     # with no unpredictable branch on the sign.
     j = np.int64(bits) >> np.int64(11)
-    if np.uint64(abs(j)) < _K[idx]:
-        return float(j) * _W[idx], state
-    return _normal_slow(idx, j, state)
+    return float(j) * _W[idx], state, np.uint64(abs(j)) < _K[idx]
+
+
+@njit(cache=True)
+def normal_redraw(state: np.uint64) -> tuple[float, np.uint64]:
+    """The normal of a draw that :func:`normal_candidate` rejected, from the stream's state
+    after that draw (whose 64 bits were ``mix(state)``)."""
+    bits = mix(state)
+    return _normal_slow(np.intp(bits & np.uint64(0xFF)), np.int64(bits) >> np.int64(11), state)
 
 
 @njit(cache=True)

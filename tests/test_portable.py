@@ -327,5 +327,5 @@ def test_small_angles_skip_the_reduction_with_the_same_bits() -> None:
     for v in x[:2000].tolist() + [0.7799999999999999]:
         r, q = portable._reduce(v)
         assert q == 0 and r == v
-    assert portable.sin_array(x).tolist() == [portable._sin_poly(v) for v in x.tolist()]
-    assert portable.cos_array(x).tolist() == [portable._cos_poly(v) for v in x.tolist()]
+    assert portable.sin_array(x).tolist() == [portable.sin_poly(v) for v in x.tolist()]
+    assert portable.cos_array(x).tolist() == [portable.cos_poly(v) for v in x.tolist()]

@@ -2,8 +2,8 @@ r"""Fused cart-pole simulation + gradient-sample kernel (numba).
 
 The reference path (``CartPole.simulate`` then :mod:`safepg.estimators`) steps every
 cart for as long as *any* cart is alive and then makes a dozen passes over (N, H, 4)
-arrays, most of whose entries are the zeros of dead steps. This kernel follows one
-trajectory at a time and stops at its last step, and gives the same numbers up to
+arrays, most of whose entries are the zeros of dead steps. This kernel steps only the
+live trajectories, each until its last step, and gives the same numbers up to
 floating-point rounding (tested). Each trajectory draws its initial state and its action
 noise inside the loop from its own counter-based stream (:mod:`safepg.streams`), as many
 normals as it lives steps; the reference path reads the same streams, so both paths see
@@ -17,10 +17,10 @@ Two things need care when the time loop stops early:
   the final :math:`G^2` of trajectories that ended at step T, and the denominators get
   their running sum over T <= l.
 - Pass 2 subtracts :math:`\sum_l G_{n,l} b_l`; the dead steps contribute
-  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps' G come from pass 1,
-  which keeps them when the batch is small enough (:data:`HISTORY_STEPS`); a bigger batch
+  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. For the live steps' G pass 2
   simulates each trajectory again from the start of its stream (the same numbers, the same
-  code, so the same bits) instead of keeping an (N, H, 4) array of cumulative scores.
+  code, so the same bits): with the step vectorised, that costs less than writing every
+  :math:`G_{n,l}` of pass 1 to memory and reading it back.
 
 As in :mod:`safepg.envs._lqg_kernel`, trajectories are processed in fixed-size chunks in
 parallel; every chunk writes its own partial sums and the chunks are reduced in order,
@@ -35,48 +35,35 @@ from numba import njit, prange
 
 from safepg import portable
 from safepg.envs._lqg_kernel import serial
-from safepg.streams import next_normal, next_uniform, stream_start
+from safepg.streams import next_uniform, normal_candidate, normal_redraw, stream_start
 
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
 #: spreads over a few threads, large enough that the per-chunk (H, 4) sums stay small.
 CHUNK = 512
-#: Largest N * H whose cumulative scores pass 1 keeps for pass 2 (2.4 * 10^7: 768 MB at most,
-#: N = 120000 at H = 200; the pages of steps not lived are never touched).
-HISTORY_STEPS = 24_000_000
 
 
-@njit(cache=True)
-def _euler(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau):
+# error_model="numpy": a float division by zero gives inf or nan, as NumPy's reference path
+# does, instead of raising; without that test in the loop the compiler can vectorise it.
+@njit(cache=True, error_model="numpy")
+def _euler(x, x_dot, beta, beta_dot, sin, cos, force, half, ml, total, pole_mass, gravity, tau):
     """One explicit-Euler step; the same operations in the same order as ``step_dynamics``."""
-    sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
-    cos = portable.cos(beta)
     push = (force + ml * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
     x_acc = push - ml * beta_acc * cos / total
     return x + tau * x_dot, x_dot + tau * x_acc, beta + tau * beta_dot, beta_dot + tau * beta_acc
 
 
-@njit(cache=True)
-def _semi_implicit(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau):
+@njit(cache=True, error_model="numpy")
+def _semi_implicit(x, x_dot, beta, beta_dot, sin, cos, force, half, ml, total, pole_mass, gravity, tau):
     """One semi-implicit Euler step (velocities first, positions with the new velocities), the
     same operations as ``step_dynamics(..., integrator="semi-implicit")``."""
-    sin = portable.sin(beta)  # not libm's: its last bit depends on the CPU (safepg.portable)
-    cos = portable.cos(beta)
     push = (force + ml * beta_dot * beta_dot * sin) / total
     beta_acc = (gravity * sin - cos * push) / (half * (4.0 / 3.0 - pole_mass * cos * cos / total))
     x_acc = push - ml * beta_acc * cos / total
     x_dot_new = x_dot + tau * x_acc
     beta_dot_new = beta_dot + tau * beta_acc
     return x + tau * x_dot_new, x_dot_new, beta + tau * beta_dot_new, beta_dot_new
-
-
-@njit(cache=True)
-def _step(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau, semi_implicit):
-    """The integrator the task asked for (a branch, so the Euler path keeps its exact operations)."""
-    if semi_implicit:
-        return _semi_implicit(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau)
-    return _euler(x, x_dot, beta, beta_dot, force, half, ml, total, pole_mass, gravity, tau)
 
 
 @njit(cache=True)
@@ -92,197 +79,180 @@ def _initial_state(key, n, init_bound):
             -init_bound + width * v3, state)
 
 
+# The packed state of a chunk's live trajectories: one flat array of rows, packed trajectory j
+# at offset row + j. One array with constant distances between its rows lets the compiler
+# prove that the rows do not overlap, which it cannot for separate arrays; it then
+# vectorises the step without run-time overlap tests. The rows are 64 bytes more than 4 KiB
+# apart: at exactly 4 KiB the 17 entries of a trajectory would share one L1 cache set, and
+# loads would wait on unrelated stores (4K aliasing), which made a step 4 times slower.
+ROW = CHUNK + 8
+X, X_DOT, BETA, BETA_DOT = 0 * ROW, 1 * ROW, 2 * ROW, 3 * ROW  # the state s
+G0, G1, G2, G3 = 4 * ROW, 5 * ROW, 6 * ROW, 7 * ROW  # the cumulative score G_t
+A0, A1, A2, A3 = 8 * ROW, 9 * ROW, 10 * ROW, 11 * ROW  # sum_t G_t w_t
+P0, P1, P2, P3 = 12 * ROW, 13 * ROW, 14 * ROW, 15 * ROW  # max |s| so far
+Z = 16 * ROW  # this step's standard normals
+SIN, COS = 17 * ROW, 18 * ROW  # sine and cosine of this step's angles
+ROWS = 19
+
+
 @njit(cache=True)
-def _first_pass(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, gamma, action_bound, x_threshold,
-                angle_threshold, score_clipped, reinforce_estimator, baseline, samples, lengths, num, den, ended,
-                kept, semi_implicit, peak, history):
-    """Simulate trajectories lo..hi-1 until they end; their samples without baseline, their
-    lengths, their largest |state component| (``peak``, the initial and the final state
-    included), and this chunk's baseline sums ``num``, ``den`` (rows, 4) and ``ended`` (H+1, 4).
+def _draw_normals(st, S, rejected, n):
+    """One standard normal from each of the first n streams ``st``, into row Z of ``S``.
 
-    Time runs in the outer loop and the chunk's live trajectories in the inner one: a step of
-    one trajectory waits on its previous step (sine, cosine, two divisions), and stepping the
-    others in between keeps the CPU busy meanwhile. Every trajectory's operations are those
-    of following it alone, and every sum over trajectories is formed in the order of their
-    indices, as before: the same bits.
-
-    ``history`` (N * H, 4), unless it has a single row: the cumulative scores G of trajectory
-    n at step t go to row n * H + t, for :func:`_second_pass_stored`.
+    The ziggurat's first comparison runs for the whole array in one branch-free (vectorised)
+    loop; the 1.5% of draws it rejects are finished one by one afterwards. Each stream's
+    numbers are those of :func:`safepg.streams.next_normal`.
     """
+    n_rejected = 0
+    for j in range(n):
+        S[Z + j], st[j], accepted = normal_candidate(st[j])
+        rejected[j] = not accepted
+        n_rejected += not accepted
+    if n_rejected:
+        for j in range(n):
+            if rejected[j]:
+                S[Z + j], st[j] = normal_redraw(st[j])
+
+
+@njit(cache=True, error_model="numpy")
+def _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, w0, w1, w2, w3, consts, x_threshold,
+             angle_threshold, semi_implicit):
+    """One step of the n packed trajectories: action, score, dynamics, peaks, and whether each
+    lives on (``alive``); returns how many ended."""
     half, ml, total, pole_mass, gravity, tau = consts
     k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
-    m = hi - lo
-    store = history.shape[0] > 1
-    st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
-    s = np.empty((m, 4))  # x, x_dot, beta, beta_dot
-    g = np.zeros((m, 4))  # cumulative scores
-    a = np.zeros((m, 4))  # G(PO)MDP sample without baseline
-    pk = np.empty((m, 4))
-    ret = np.zeros(m)
-    T = np.full(m, H)
-    live = np.empty(m, dtype=np.intp)  # indices of the live trajectories, in increasing order
-    for i in range(m):
-        s[i, 0], s[i, 1], s[i, 2], s[i, 3], st[i] = _initial_state(key, lo + i, init_bound)
-        for p in range(4):
-            pk[i, p] = abs(s[i, p])
-        live[i] = i
-    n_live = m
-    disc = 1.0
-    for t in range(H):
-        if n_live == 0:
-            break
-        kept_live = 0
-        for j in range(n_live):
-            i = live[j]
-            x, x_dot, beta, beta_dot = s[i, 0], s[i, 1], s[i, 2], s[i, 3]
-            mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            zt, st[i] = next_normal(st[i])
-            a_raw = mean + sigma * zt
-            u = min(max(a_raw, -action_bound), action_bound)
-            d = ((u if score_clipped else a_raw) - mean) * inv_var
-            g0 = g[i, 0] + d * x
-            g1 = g[i, 1] + d * x_dot
-            g2 = g[i, 2] + d * beta
-            g3 = g[i, 3] + d * beta_dot
-            g[i, 0], g[i, 1], g[i, 2], g[i, 3] = g0, g1, g2, g3
-            if store:
-                row = (lo + i) * H + t
-                history[row, 0], history[row, 1], history[row, 2], history[row, 3] = g0, g1, g2, g3
-            ret[i] += disc  # reward 1: alive at t (the step into a failing state counts)
-            if not reinforce_estimator:
-                a[i, 0] += g0 * disc
-                a[i, 1] += g1 * disc
-                a[i, 2] += g2 * disc
-                a[i, 3] += g3 * disc
-                if baseline:
-                    num[t, 0] += g0 * g0 * disc
-                    num[t, 1] += g1 * g1 * disc
-                    num[t, 2] += g2 * g2 * disc
-                    num[t, 3] += g3 * g3 * disc
-                    den[t, 0] += g0 * g0
-                    den[t, 1] += g1 * g1
-                    den[t, 2] += g2 * g2
-                    den[t, 3] += g3 * g3
-            x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass, gravity, tau,
-                                             semi_implicit)
-            s[i, 0], s[i, 1], s[i, 2], s[i, 3] = x, x_dot, beta, beta_dot
-            pk[i, 0] = max(pk[i, 0], abs(x))
-            pk[i, 1] = max(pk[i, 1], abs(x_dot))
-            pk[i, 2] = max(pk[i, 2], abs(beta))
-            pk[i, 3] = max(pk[i, 3], abs(beta_dot))
-            # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
-            if not (abs(x) <= x_threshold and abs(beta) <= angle_threshold):
-                T[i] = t + 1
-            else:
-                live[kept_live] = i  # compacted in place, order kept
-                kept_live += 1
-        n_live = kept_live
-        disc *= gamma
-    for i in range(m):
-        n = lo + i
-        lengths[n] = T[i]
-        for p in range(4):
-            peak[n, p] = pk[i, p]
-        g0, g1, g2, g3 = g[i, 0], g[i, 1], g[i, 2], g[i, 3]
-        if reinforce_estimator:
-            r = ret[i]
-            samples[n, 0] = g0 * r
-            samples[n, 1] = g1 * r
-            samples[n, 2] = g2 * r
-            samples[n, 3] = g3 * r
-            if baseline:
-                num[0, 0] += g0 * g0 * r
-                num[0, 1] += g1 * g1 * r
-                num[0, 2] += g2 * g2 * r
-                num[0, 3] += g3 * g3 * r
-                den[0, 0] += g0 * g0
-                den[0, 1] += g1 * g1
-                den[0, 2] += g2 * g2
-                den[0, 3] += g3 * g3
-                kept[n, 0], kept[n, 1], kept[n, 2], kept[n, 3] = g0, g1, g2, g3
+    # portable.sin/cos, not libm's: libm's last bit depends on the CPU (safepg.portable).
+    # Every live angle is within the threshold; below 0.78 rad they are their polynomials
+    # alone (the reduction is the identity there), with no branch, so this loop vectorises.
+    if angle_threshold < 0.78:
+        for j in range(n):
+            S[SIN + j] = portable.sin_poly(S[BETA + j])
+            S[COS + j] = portable.cos_poly(S[BETA + j])
+    else:
+        for j in range(n):
+            S[SIN + j] = portable.sin(S[BETA + j])
+            S[COS + j] = portable.cos(S[BETA + j])
+    n_ended = 0
+    for j in range(n):
+        s0, s1, s2, s3 = S[X + j], S[X_DOT + j], S[BETA + j], S[BETA_DOT + j]
+        mean = k0 * s0 + k1 * s1 + k2 * s2 + k3 * s3
+        a_raw = mean + sigma * S[Z + j]
+        u = min(max(a_raw, -action_bound), action_bound)
+        d = ((u if score_clipped else a_raw) - mean) * inv_var
+        c0 = S[G0 + j] + d * s0
+        c1 = S[G1 + j] + d * s1
+        c2 = S[G2 + j] + d * s2
+        c3 = S[G3 + j] + d * s3
+        S[G0 + j], S[G1 + j], S[G2 + j], S[G3 + j] = c0, c1, c2, c3
+        S[A0 + j] += c0 * w0
+        S[A1 + j] += c1 * w1
+        S[A2 + j] += c2 * w2
+        S[A3 + j] += c3 * w3
+        sin, cos = S[SIN + j], S[COS + j]
+        if semi_implicit:
+            s0, s1, s2, s3 = _semi_implicit(s0, s1, s2, s3, sin, cos, u, half, ml, total, pole_mass, gravity, tau)
         else:
-            samples[n, 0], samples[n, 1], samples[n, 2], samples[n, 3] = a[i, 0], a[i, 1], a[i, 2], a[i, 3]
-            if baseline and T[i] < H:
-                ended[T[i], 0] += g0 * g0
-                ended[T[i], 1] += g1 * g1
-                ended[T[i], 2] += g2 * g2
-                ended[T[i], 3] += g3 * g3
+            s0, s1, s2, s3 = _euler(s0, s1, s2, s3, sin, cos, u, half, ml, total, pole_mass, gravity, tau)
+        S[X + j], S[X_DOT + j], S[BETA + j], S[BETA_DOT + j] = s0, s1, s2, s3
+        S[P0 + j] = max(S[P0 + j], abs(s0))
+        S[P1 + j] = max(S[P1 + j], abs(s1))
+        S[P2 + j] = max(S[P2 + j], abs(s2))
+        S[P3 + j] = max(S[P3 + j], abs(s3))
+        # "not <=" so that a NaN state also ends the episode, as in CartPole.alive.
+        ok = abs(s0) <= x_threshold and abs(s2) <= angle_threshold
+        alive[j] = ok
+        n_ended += not ok
+    return n_ended
 
 
 @njit(cache=True)
-def _second_pass(lo, hi, K, sigma, inv_var, consts, key, init_bound, action_bound, score_clipped, b, suffix,
-                 samples, lengths, semi_implicit):
-    """Subtract sum_l G_{n,l} b_l from the G(PO)MDP samples lo..hi-1, simulating them again
-    (time outside, trajectories inside, as in :func:`_first_pass`)."""
-    half, ml, total, pole_mass, gravity, tau = consts
-    k0, k1, k2, k3 = K[0], K[1], K[2], K[3]
+def _simulate_chunk(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, weight, action_bound,
+                    x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num, den, sums, out_a, out_g,
+                    lengths, peak):
+    r"""Simulate trajectories lo..hi-1 until they end, with their scores.
+
+    For each trajectory n and step t < T_n: the cumulative score
+    :math:`G_t = \sum_{k \le t} (a_k - \mu_k) \phi_k / \sigma^2`, and the weighted sum
+    :math:`A = \sum_{t < T} G_t \odot w_t`, with ``weight`` :math:`w_t` (H, 4): the discount
+    :math:`\gamma^t` for G(PO)MDP's sample, the baseline :math:`b_t` for its second pass.
+    Written per trajectory: ``out_a`` (A), ``out_g`` (the last :math:`G_{T-1}`), ``lengths``
+    (T) and ``peak`` (max |s| over its states, initial and final included).
+    With ``sums``: this chunk's baseline sums ``num[t] += G_t^2 disc_t``, ``den[t] += G_t^2``.
+
+    The chunk's live trajectories are kept packed, in the order of their indices (rows of
+    ``S``, above). Each step is a few loops over them: the normals (:func:`_draw_normals`);
+    the policy, the scores and the dynamics in one branch-free loop that the compiler
+    vectorises (:func:`_advance`); the sums over trajectories, in index order; then the
+    ended trajectories leave the pack. Every trajectory's operations are those of following
+    it alone and every sum over trajectories is formed in index order, as in the reference
+    path: the same bits, whatever the vector width (``tests/test_portable.py``).
+    """
     m = hi - lo
-    st = np.empty(m, dtype=np.uint64)
-    s = np.empty((m, 4))
-    g = np.zeros((m, 4))
-    a = np.zeros((m, 4))  # sum_l G_l b_l over the live steps
-    T = np.empty(m, dtype=np.intp)
-    live = np.empty(m, dtype=np.intp)
-    H = 0
+    S = np.zeros(ROWS * ROW)
+    idx = np.empty(m, dtype=np.intp)  # chunk index of each packed trajectory
+    st = np.empty(m, dtype=np.uint64)  # its stream
+    rejected = np.empty(m, dtype=np.bool_)
+    alive = np.empty(m, dtype=np.bool_)
     for i in range(m):
-        s[i, 0], s[i, 1], s[i, 2], s[i, 3], st[i] = _initial_state(key, lo + i, init_bound)
-        T[i] = int(lengths[lo + i])
-        H = max(H, T[i])
-        live[i] = i
-    n_live = m
-    # Pass 1's trajectories again, operation for operation: each ends at its T, no need to test.
+        S[X + i], S[X_DOT + i], S[BETA + i], S[BETA_DOT + i], st[i] = _initial_state(key, lo + i, init_bound)
+        for r in range(4):
+            S[P0 + r * ROW + i] = abs(S[X + r * ROW + i])
+        idx[i] = i
+    n = m
     for t in range(H):
-        kept_live = 0
-        for j in range(n_live):
-            i = live[j]
-            x, x_dot, beta, beta_dot = s[i, 0], s[i, 1], s[i, 2], s[i, 3]
-            mean = k0 * x + k1 * x_dot + k2 * beta + k3 * beta_dot
-            zt, st[i] = next_normal(st[i])
-            a_raw = mean + sigma * zt
-            u = min(max(a_raw, -action_bound), action_bound)
-            d = ((u if score_clipped else a_raw) - mean) * inv_var
-            g0 = g[i, 0] + d * x
-            g1 = g[i, 1] + d * x_dot
-            g2 = g[i, 2] + d * beta
-            g3 = g[i, 3] + d * beta_dot
-            g[i, 0], g[i, 1], g[i, 2], g[i, 3] = g0, g1, g2, g3
-            a[i, 0] += g0 * b[t, 0]
-            a[i, 1] += g1 * b[t, 1]
-            a[i, 2] += g2 * b[t, 2]
-            a[i, 3] += g3 * b[t, 3]
-            if t + 1 < T[i]:  # the state after the last step is never used
-                x, x_dot, beta, beta_dot = _step(x, x_dot, beta, beta_dot, u, half, ml, total, pole_mass,
-                                                 gravity, tau, semi_implicit)
-                s[i, 0], s[i, 1], s[i, 2], s[i, 3] = x, x_dot, beta, beta_dot
-                live[kept_live] = i
-                kept_live += 1
-        n_live = kept_live
-    for i in range(m):
-        n, Ti = lo + i, T[i]
-        samples[n, 0] -= a[i, 0] + g[i, 0] * suffix[Ti, 0]
-        samples[n, 1] -= a[i, 1] + g[i, 1] * suffix[Ti, 1]
-        samples[n, 2] -= a[i, 2] + g[i, 2] * suffix[Ti, 2]
-        samples[n, 3] -= a[i, 3] + g[i, 3] * suffix[Ti, 3]
+        if n == 0:
+            break
+        _draw_normals(st, S, rejected, n)
+        n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, weight[t, 0],
+                           weight[t, 1], weight[t, 2], weight[t, 3], consts, x_threshold, angle_threshold,
+                           semi_implicit)
+        if sums:
+            _sums(n, S, disc[t], num[t], den[t])
+        if n_ended == 0:
+            continue
+        kept = 0
+        for j in range(n):
+            if not alive[j]:
+                _finish(lo + idx[j], t + 1, S, j, out_a, out_g, lengths, peak)
+                continue
+            if kept != j:
+                idx[kept], st[kept] = idx[j], st[j]
+                for r in range(16):  # the rows up to Z, which the next step draws afresh
+                    S[r * ROW + kept] = S[r * ROW + j]
+            kept += 1
+        n = kept
+    for j in range(n):  # alive at the horizon
+        _finish(lo + idx[j], H, S, j, out_a, out_g, lengths, peak)
 
 
 @njit(cache=True)
-def _second_pass_stored(lo, hi, H, history, b, suffix, samples, lengths):
-    """:func:`_second_pass` from the cumulative scores pass 1 stored: the same terms added in
-    the same order, so the same bits, without simulating again."""
-    for n in range(lo, hi):
-        T = int(lengths[n])
-        a0 = a1 = a2 = a3 = 0.0
-        for t in range(T):
-            row = n * H + t
-            a0 += history[row, 0] * b[t, 0]
-            a1 += history[row, 1] * b[t, 1]
-            a2 += history[row, 2] * b[t, 2]
-            a3 += history[row, 3] * b[t, 3]
-        last = n * H + T - 1
-        samples[n, 0] -= a0 + history[last, 0] * suffix[T, 0]
-        samples[n, 1] -= a1 + history[last, 1] * suffix[T, 1]
-        samples[n, 2] -= a2 + history[last, 2] * suffix[T, 2]
-        samples[n, 3] -= a3 + history[last, 3] * suffix[T, 3]
+def _sums(n, S, dt, num, den):
+    """num += sum_j G_j^2 dt and den += sum_j G_j^2 over the n packed trajectories, added in
+    index order (the reference path's order, so the same bits), in registers."""
+    n0, n1, n2, n3 = num[0], num[1], num[2], num[3]
+    d0, d1, d2, d3 = den[0], den[1], den[2], den[3]
+    for j in range(n):
+        c0, c1, c2, c3 = S[G0 + j], S[G1 + j], S[G2 + j], S[G3 + j]
+        n0 += c0 * c0 * dt
+        n1 += c1 * c1 * dt
+        n2 += c2 * c2 * dt
+        n3 += c3 * c3 * dt
+        d0 += c0 * c0
+        d1 += c1 * c1
+        d2 += c2 * c2
+        d3 += c3 * c3
+    num[0], num[1], num[2], num[3] = n0, n1, n2, n3
+    den[0], den[1], den[2], den[3] = d0, d1, d2, d3
+
+
+@njit(cache=True)
+def _finish(n, T, S, j, out_a, out_g, lengths, peak):
+    """Write the results of trajectory n, packed at j, which ended after T steps."""
+    for p in range(4):
+        out_a[n, p] = S[A0 + p * ROW + j]
+        out_g[n, p] = S[G0 + p * ROW + j]
+        peak[n, p] = S[P0 + p * ROW + j]
+    lengths[n] = T
 
 
 @njit(cache=True)
@@ -331,7 +301,7 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                               x_threshold: float, angle_threshold: float,
                               score_clipped: bool, reinforce_estimator: bool,
                               baseline: bool, semi_implicit: bool = False, polemass_length: float | None = None,
-                              peaks: bool = False, history_steps: int = HISTORY_STEPS) -> tuple[np.ndarray, ...]:
+                              peaks: bool = False) -> tuple[np.ndarray, ...]:
     """Per-trajectory REINFORCE or G(PO)MDP samples (N, 4) and episode lengths (N,).
 
     Parameters
@@ -364,9 +334,6 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         :func:`safepg.envs.cartpole.step_dynamics`).
     peaks : bool
         Also return each trajectory's largest |state component|.
-    history_steps : int
-        G(PO)MDP with baseline: the largest N * H whose cumulative scores pass 1 keeps for
-        pass 2; above it pass 2 simulates again (the same bits either way).
 
     Returns
     -------
@@ -393,57 +360,88 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
                                     float(tau), np.uint64(key), int(n), int(horizon), float(init_bound),
                                     float(gamma), float(action_bound), float(x_threshold),
                                     float(angle_threshold), bool(score_clipped), bool(reinforce_estimator),
-                                    bool(baseline), bool(semi_implicit), int(history_steps))
+                                    bool(baseline), bool(semi_implicit))
     return (samples, lengths, peak) if peaks else (samples, lengths)
 
 
 @njit(cache=True, parallel=True)
 def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, init_bound, gamma, action_bound,
-           x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit, history_steps):
+           x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
     """:func:`cartpole_gradient_samples` on normalised arguments."""
     n_chunks = (N + CHUNK - 1) // CHUNK
-    samples = np.zeros((N, 4))
+    samples = np.empty((N, 4))
+    last_g = np.empty((N, 4))
     lengths = np.empty(N)
     peak = np.empty((N, 4))
     gpomdp_baseline = baseline and not reinforce_estimator
-    rows = 1 if reinforce_estimator else H
-    num = np.zeros((n_chunks if baseline else 1, rows, 4))
-    den = np.zeros((n_chunks if baseline else 1, rows, 4))
-    # Final G^2 of the trajectories of a chunk that ended at step T (index T), see above.
-    ended = np.zeros((n_chunks if gpomdp_baseline else 1, H + 1, 4))
-    # REINFORCE's baseline needs only the total score S_n, not a second simulation.
-    kept = np.empty((N if baseline and reinforce_estimator else 1, 4))
-    # G(PO)MDP's cumulative scores, kept for pass 2 up to history_steps trajectory-steps (32
-    # bytes each; only the steps lived are written); a bigger batch simulates pass 2 again.
-    store = gpomdp_baseline and N * H <= history_steps
-    history = np.empty((N * H if store else 1, 4))
+    disc = np.empty(H + 1)  # gamma^t as the running product
+    disc[0] = 1.0
+    for t in range(H):
+        disc[t + 1] = disc[t] * gamma
+    weight = np.empty((H, 4))  # G(PO)MDP's sample sums G_t gamma^t; REINFORCE's needs no sum
+    for t in range(H):
+        for p in range(4):
+            weight[t, p] = 0.0 if reinforce_estimator else disc[t]
+    num = np.zeros((n_chunks if gpomdp_baseline else 1, H, 4))
+    den = np.zeros((n_chunks if gpomdp_baseline else 1, H, 4))
     inv_var = 1.0 / (sigma * sigma)
     consts = (half, ml, cart_mass + pole_mass, pole_mass, gravity, tau)
     # Without a baseline the sums are never touched: every chunk gets the same dummy row.
-    i_step = 1 if baseline else 0
-    j_step = 1 if gpomdp_baseline else 0
+    i_step = 1 if gpomdp_baseline else 0
     for c in prange(n_chunks):
         i = c * i_step
-        j = c * j_step
-        _first_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, gamma,
-                    action_bound, x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline,
-                    samples, lengths, num[i], den[i], ended[j], kept, semi_implicit, peak, history)
+        _simulate_chunk(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, weight,
+                        action_bound, x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num[i],
+                        den[i], gpomdp_baseline, samples, last_g, lengths, peak)
+
+    if reinforce_estimator:
+        ret = np.zeros(H + 1)  # the discounted return of a trajectory of length T, sum_{t<T} gamma^t
+        for t in range(H):
+            ret[t + 1] = ret[t] + disc[t]
+        for n in range(N):
+            r = ret[int(lengths[n])]
+            for p in range(4):
+                samples[n, p] = last_g[n, p] * r
+        if not baseline:
+            return samples, lengths, peak
+        # b = sum_n S_n^2 R_n / sum_n S_n^2, each chunk summed in index order, the chunks in order.
+        num1 = np.zeros((n_chunks, 1, 4))
+        den1 = np.zeros((n_chunks, 1, 4))
+        for n in range(N):
+            c = n // CHUNK
+            r = ret[int(lengths[n])]
+            for p in range(4):
+                num1[c, 0, p] += last_g[n, p] * last_g[n, p] * r
+                den1[c, 0, p] += last_g[n, p] * last_g[n, p]
+        b, _ = _baseline(num1, den1, np.zeros((1, H + 1, 4)), False)
+        for n in range(N):
+            for p in range(4):
+                samples[n, p] -= last_g[n, p] * b[0, p]
+        return samples, lengths, peak
     if not baseline:
         return samples, lengths, peak
 
-    b, suffix = _baseline(num, den, ended, gpomdp_baseline)
-    if reinforce_estimator:
-        for n in range(N):
+    # Final G^2 of the trajectories of each chunk that ended at step T < H (index T), in index
+    # order: after its end a trajectory's G stays in the denominators (module docstring).
+    ended = np.zeros((n_chunks, H + 1, 4))
+    for n in range(N):
+        T = int(lengths[n])
+        if T < H:
             for p in range(4):
-                samples[n, p] -= kept[n, p] * b[0, p]
-        return samples, lengths, peak
-
+                ended[n // CHUNK, T, p] += last_g[n, p] * last_g[n, p]
+    b, suffix = _baseline(num, den, ended, True)
+    a = np.empty((N, 4))  # sum_{t<T} G_t b_t
     for c in prange(n_chunks):
-        if store:
-            _second_pass_stored(c * CHUNK, min(N, (c + 1) * CHUNK), H, history, b, suffix, samples, lengths)
-        else:
-            _second_pass(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, init_bound,
-                         action_bound, score_clipped, b, suffix, samples, lengths, semi_implicit)
+        # Pass 2 simulates the chunk again from its streams, with weight b: the same
+        # trajectories, bit for bit (it rewrites last_g, lengths and peak with the same values).
+        # Cheaper than keeping every G_t of pass 1: 32 bytes a step to write and read back.
+        _simulate_chunk(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, b,
+                        action_bound, x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num[0],
+                        den[0], False, a, last_g, lengths, peak)
+    for n in range(N):
+        T = int(lengths[n])
+        for p in range(4):
+            samples[n, p] -= a[n, p] + last_g[n, p] * suffix[T, p]
     return samples, lengths, peak
 
 
