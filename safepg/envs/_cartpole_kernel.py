@@ -35,7 +35,7 @@ from numba import njit, prange
 
 from safepg import portable
 from safepg.envs._lqg_kernel import serial
-from safepg.streams import next_uniform, normal_candidate, normal_redraw, stream_start
+from safepg.streams import draw_normals, next_uniform, stream_start
 
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
@@ -93,25 +93,6 @@ P0, P1, P2, P3 = 12 * ROW, 13 * ROW, 14 * ROW, 15 * ROW  # max |s| so far
 Z = 16 * ROW  # this step's standard normals
 SIN, COS = 17 * ROW, 18 * ROW  # sine and cosine of this step's angles
 ROWS = 19
-
-
-@njit(cache=True)
-def _draw_normals(st, S, rejected, n):
-    """One standard normal from each of the first n streams ``st``, into row Z of ``S``.
-
-    The ziggurat's first comparison runs for the whole array in one branch-free (vectorised)
-    loop; the 1.5% of draws it rejects are finished one by one afterwards. Each stream's
-    numbers are those of :func:`safepg.streams.next_normal`.
-    """
-    n_rejected = 0
-    for j in range(n):
-        S[Z + j], st[j], accepted = normal_candidate(st[j])
-        rejected[j] = not accepted
-        n_rejected += not accepted
-    if n_rejected:
-        for j in range(n):
-            if rejected[j]:
-                S[Z + j], st[j] = normal_redraw(st[j])
 
 
 @njit(cache=True, error_model="numpy")
@@ -180,7 +161,7 @@ def _simulate_chunk(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, weigh
     With ``sums``: this chunk's baseline sums ``num[t] += G_t^2 disc_t``, ``den[t] += G_t^2``.
 
     The chunk's live trajectories are kept packed, in the order of their indices (rows of
-    ``S``, above). Each step is a few loops over them: the normals (:func:`_draw_normals`);
+    ``S``, above). Each step is a few loops over them: the normals (:func:`safepg.streams.draw_normals`);
     the policy, the scores and the dynamics in one branch-free loop that the compiler
     vectorises (:func:`_advance`); the sums over trajectories, in index order; then the
     ended trajectories leave the pack. Every trajectory's operations are those of following
@@ -202,7 +183,7 @@ def _simulate_chunk(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, weigh
     for t in range(H):
         if n == 0:
             break
-        _draw_normals(st, S, rejected, n)
+        draw_normals(st, S, Z, rejected, n)
         n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, weight[t, 0],
                            weight[t, 1], weight[t, 2], weight[t, 3], consts, x_threshold, angle_threshold,
                            semi_implicit)

@@ -20,22 +20,32 @@ import types
 import numpy as np
 from numba import njit, prange
 
-from safepg.streams import next_normal, next_uniform, stream_start
+from safepg.streams import draw_normals, next_normal, next_uniform, stream_start
 
 CHUNK = 2048
 
 
-@njit(cache=True, parallel=True)
+# A chunk's per-trajectory quantities in one flat array of rows, trajectory i at row + i: one
+# array with constant distances between rows lets the compiler prove that they do not
+# overlap and vectorise the step without run-time tests. The rows are 64 bytes more than a
+# multiple of 4 KiB apart, so that a trajectory's entries do not share a cache set (4K
+# aliasing, which stalls loads behind unrelated stores).
+ROW = CHUNK + 8
+S1, CUM1, ACC1, RET1, Z1, DR1 = 0 * ROW, 1 * ROW, 2 * ROW, 3 * ROW, 4 * ROW, 5 * ROW
+ROWS1 = 6
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
 def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                            reinforce_estimator, baseline):
     """Scalar (m = 1) version of :func:`lqg_gradient_samples`.
 
-    Section 5.1's campaign is almost all scalar steps; with scalars in registers this
-    runs about twice as fast as the matrix loops below at m = 1. Within a chunk, time runs
-    in the outer loop and the trajectories in the inner one, so that consecutive steps of
-    different trajectories overlap (about 13% faster than following one trajectory at a
-    time); every trajectory's operations and every sum's order over trajectories are those
-    of following them one by one: the same bits.
+    Section 5.1's campaign is almost all scalar steps. Within a chunk, time runs in the outer
+    loop and the chunk's trajectories in the inner ones, three per step: the normals for all
+    of them (:func:`safepg.streams.draw_normals`); the policy, reward, score and dynamics in
+    one branch-free loop that the compiler vectorises (:func:`_step1d`); then the baseline
+    sums over trajectories in index order. Every trajectory's operations and every sum's
+    order are those of following the trajectories one by one: the same bits.
     """
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.empty((N, 1))
@@ -43,64 +53,79 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
     rows = 1 if reinforce_estimator else H
     num = np.zeros((n_chunks, rows))
     den = np.zeros((n_chunks, rows))
-    kept = np.empty((N if baseline else 1, rows))
+    # G_{n,t} for pass 2, time-major: step t of a chunk writes, and pass 2 reads, one run of memory.
+    kept = np.empty((rows, N if baseline else 1))
     inv_var = 1.0 / (sigma * sigma)
     for c in prange(n_chunks):
         lo = c * CHUNK
         m = min(N, lo + CHUNK) - lo
+        T = np.zeros(ROWS1 * ROW)
         st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
-        s = np.empty(m)
-        cum = np.zeros(m)
-        acc = np.zeros(m)
-        ret = np.zeros(m)
+        rejected = np.empty(m, dtype=np.bool_)
         for i in range(m):
             state = stream_start(key, lo + i)
             u0, st[i] = next_uniform(state)
-            s[i] = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
+            T[S1 + i] = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
         disc = 1.0
         for t in range(H):
-            for i in range(m):
-                si = s[i]
-                mean = theta * si
-                zt, st[i] = next_normal(st[i])
-                a_raw = mean + sigma * zt
-                u = min(max(a_raw, -ba), ba) if clip else a_raw
-                dr = -0.5 * (Q * si * si + R * u * u) * disc
-                ret[i] += dr
-                g = cum[i] + ((u if score_clipped else a_raw) - mean) * si * inv_var
-                cum[i] = g
-                if not reinforce_estimator:
-                    acc[i] += g * dr
-                    num[c, t] += g * g * dr
-                    den[c, t] += g * g
+            draw_normals(st, T, Z1, rejected, m)
+            _step1d(m, T, theta, sigma, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator, inv_var)
+            if not reinforce_estimator:
+                nt, dt = num[c, t], den[c, t]
+                for i in range(m):  # in index order
+                    g = T[CUM1 + i]
+                    nt += g * g * T[DR1 + i]
+                    dt += g * g
                     if baseline:
-                        kept[lo + i, t] = g
-                s_next = A * si + B * u
-                s[i] = min(max(s_next, -bs), bs) if clip else s_next
+                        kept[t, lo + i] = g
+                num[c, t], den[c, t] = nt, dt
             disc *= gamma
         for i in range(m):
             n = lo + i
-            returns[n] = ret[i]
+            returns[n] = T[RET1 + i]
             if reinforce_estimator:
-                g = cum[i]
-                num[c, 0] += g * g * ret[i]
+                g = T[CUM1 + i]
+                num[c, 0] += g * g * T[RET1 + i]
                 den[c, 0] += g * g
-                acc[i] = g * ret[i]
+                T[ACC1 + i] = g * T[RET1 + i]
                 if baseline:
-                    kept[n, 0] = g
-            samples[n, 0] = acc[i]
+                    kept[0, n] = g
+            samples[n, 0] = T[ACC1 + i]
     if baseline:
         b = _baseline(num, den)
         for c in prange(n_chunks):
-            for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-                acc = 0.0
-                for t in range(rows):
-                    acc += kept[n, t] * b[t]
-                samples[n, 0] -= acc
+            lo, hi = c * CHUNK, min(N, (c + 1) * CHUNK)
+            acc = np.zeros(hi - lo)  # sum_t G_{n,t} b_t, added in t order for each n
+            for t in range(rows):
+                bt = b[t]
+                for n in range(lo, hi):
+                    acc[n - lo] += kept[t, n] * bt
+            for n in range(lo, hi):
+                samples[n, 0] -= acc[n - lo]
     return samples, returns
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy")
+def _step1d(m, T, theta, sigma, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator, inv_var):
+    """One step of the chunk's m trajectories (rows of ``T``); ``T[DR1 + i]`` keeps each
+    trajectory's discounted reward of the step for the baseline sums."""
+    for i in range(m):
+        si = T[S1 + i]
+        mean = theta * si
+        a_raw = mean + sigma * T[Z1 + i]
+        u = min(max(a_raw, -ba), ba) if clip else a_raw
+        dr = -0.5 * (Q * si * si + R * u * u) * disc
+        T[DR1 + i] = dr
+        T[RET1 + i] += dr
+        g = T[CUM1 + i] + ((u if score_clipped else a_raw) - mean) * si * inv_var
+        T[CUM1 + i] = g
+        if not reinforce_estimator:
+            T[ACC1 + i] += g * dr
+        s_next = A * si + B * u
+        T[S1 + i] = min(max(s_next, -bs), bs) if clip else s_next
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
 def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                            reinforce_estimator, baseline):
     """Two-dimensional (m = 2) version of :func:`lqg_gradient_samples`.
@@ -108,18 +133,14 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
     Same arguments, semantics and outputs (samples (N, 4), returns (N,)). Section 5.2's
     campaign is all m = 2 steps; the runtime-sized m x m loops of the generic kernel keep
     state, action, scores and sample sums in memory and index every matrix through its
-    strides, which dominates at m = 2. Here the 2 x 2 algebra is unrolled: the matrices
-    are read once into locals and the per-trajectory state (s, a, u, the four cumulative
-    scores, the four sample sums) lives in registers. The only per-step memory traffic
-    left is adding to the chunk's L1-resident baseline sums
-    num/den[c, t, :] and, with a G(PO)MDP baseline, storing the four cumulative scores
-    kept[n, t, :] contiguously (pass 2 needs them).
+    strides, which dominates at m = 2. Here the 2 x 2 algebra is unrolled, and, as in
+    :func:`lqg1d_gradient_samples`, time runs outside and each step is three loops over the
+    chunk's trajectories: their two normals each, the step vectorised (:func:`_step2d`),
+    and the baseline sums in index order (:func:`_sums2d`).
 
     Every sum is formed in the same order as in the generic kernel, so the two give the
     same bits (tested to 1e-12 relative); swapping kernels does not change a seeded run.
     That rules out regrouping the cost quadratic forms to save a few multiplies.
-    Interleaving two trajectories, to overlap their serial state -> action -> state
-    chains, measured no faster: the step is bound by scalar arithmetic, not latency.
 
     Parameters
     ----------
@@ -150,94 +171,32 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
     rows = 1 if reinforce_estimator else H
     num = np.zeros((n_chunks, rows, 4))
     den = np.zeros((n_chunks, rows, 4))
-    kept = np.empty((N if baseline else 1, rows, 4))
-    k00, k01, k10, k11 = K[0, 0], K[0, 1], K[1, 0], K[1, 1]
-    l00, l10, l11 = L[0, 0], L[1, 0], L[1, 1]
-    p00, p01, p10, p11 = Pm[0, 0], Pm[0, 1], Pm[1, 0], Pm[1, 1]
-    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
-    b00, b01, b10, b11 = B[0, 0], B[0, 1], B[1, 0], B[1, 1]
-    q00, q01, q10, q11 = Q[0, 0], Q[0, 1], Q[1, 0], Q[1, 1]
-    r00, r01, r10, r11 = R[0, 0], R[0, 1], R[1, 0], R[1, 1]
+    kept = np.empty((rows, 4, N if baseline else 1))  # time-major, as in the 1-D kernel
     for c in prange(n_chunks):
-        for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-            state = stream_start(key, n)
+        lo = c * CHUNK
+        m = min(N, lo + CHUNK) - lo
+        T = np.zeros(ROWS2 * ROW)
+        st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
+        rejected = np.empty(m, dtype=np.bool_)
+        for i in range(m):
+            state = stream_start(key, lo + i)
             v0, state = next_uniform(state)
-            v1, state = next_uniform(state)
-            x0 = -bs + (bs + bs) * v0
-            x1 = -bs + (bs + bs) * v1
-            g00 = 0.0
-            g01 = 0.0
-            g10 = 0.0
-            g11 = 0.0
-            f00 = 0.0
-            f01 = 0.0
-            f10 = 0.0
-            f11 = 0.0
-            disc = 1.0
-            ret = 0.0
-            for t in range(H):
-                m0 = k00 * x0 + k01 * x1
-                m1 = k10 * x0 + k11 * x1
-                z0, state = next_normal(state)
-                z1, state = next_normal(state)
-                a0 = m0 + l00 * z0
-                a1 = m1 + (l10 * z0 + l11 * z1)
-                if clip:
-                    u0 = min(max(a0, -ba), ba)
-                    u1 = min(max(a1, -ba), ba)
-                else:
-                    u0 = a0
-                    u1 = a1
-                # (i, j) terms summed in the generic kernel's order, so results match bit for bit.
-                cost = (x0 * q00 * x0 + u0 * r00 * u0) + (x0 * q01 * x1 + u0 * r01 * u1)
-                cost = cost + (x1 * q10 * x0 + u1 * r10 * u0)
-                cost = cost + (x1 * q11 * x1 + u1 * r11 * u1)
-                dr = -0.5 * cost * disc
-                ret += dr
-                if score_clipped:
-                    e0 = u0 - m0
-                    e1 = u1 - m1
-                else:
-                    e0 = a0 - m0
-                    e1 = a1 - m1
-                d0 = p00 * e0 + p01 * e1
-                d1 = p10 * e0 + p11 * e1
-                g00 += d0 * x0  # score of Section 2.3.13, summed over k <= t
-                g01 += d0 * x1
-                g10 += d1 * x0
-                g11 += d1 * x1
-                if not reinforce_estimator:
-                    f00 += g00 * dr
-                    f01 += g01 * dr
-                    f10 += g10 * dr
-                    f11 += g11 * dr
-                    h00 = g00 * g00
-                    h01 = g01 * g01
-                    h10 = g10 * g10
-                    h11 = g11 * g11
-                    num[c, t, 0] += h00 * dr
-                    num[c, t, 1] += h01 * dr
-                    num[c, t, 2] += h10 * dr
-                    num[c, t, 3] += h11 * dr
-                    den[c, t, 0] += h00
-                    den[c, t, 1] += h01
-                    den[c, t, 2] += h10
-                    den[c, t, 3] += h11
-                    if baseline:
-                        kept[n, t, 0] = g00
-                        kept[n, t, 1] = g01
-                        kept[n, t, 2] = g10
-                        kept[n, t, 3] = g11
-                disc *= gamma
-                y0 = (a00 * x0 + b00 * u0) + (a01 * x1 + b01 * u1)
-                y1 = (a10 * x0 + b10 * u0) + (a11 * x1 + b11 * u1)
-                if clip:
-                    x0 = min(max(y0, -bs), bs)
-                    x1 = min(max(y1, -bs), bs)
-                else:
-                    x0 = y0
-                    x1 = y1
+            v1, st[i] = next_uniform(state)
+            T[X0 + i] = -bs + (bs + bs) * v0
+            T[X1 + i] = -bs + (bs + bs) * v1
+        disc = 1.0
+        for t in range(H):
+            draw_normals(st, T, Z0, rejected, m)  # each stream: z0, then z1
+            draw_normals(st, T, Z1_, rejected, m)
+            _step2d(m, T, K, L, Pm, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator)
+            if not reinforce_estimator:
+                _sums2d(m, T, num[c, t], den[c, t], kept, lo, t, baseline)
+            disc *= gamma
+        for i in range(m):
+            n = lo + i
+            ret = T[RET2 + i]
             returns[n] = ret
+            g00, g01, g10, g11 = T[G00 + i], T[G01 + i], T[G10 + i], T[G11 + i]
             if reinforce_estimator:
                 h00 = g00 * g00
                 h01 = g01 * g01
@@ -251,37 +210,131 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
                 den[c, 0, 1] += h01
                 den[c, 0, 2] += h10
                 den[c, 0, 3] += h11
-                f00 = g00 * ret
-                f01 = g01 * ret
-                f10 = g10 * ret
-                f11 = g11 * ret
+                samples[n, 0] = g00 * ret
+                samples[n, 1] = g01 * ret
+                samples[n, 2] = g10 * ret
+                samples[n, 3] = g11 * ret
                 if baseline:
-                    kept[n, 0, 0] = g00
-                    kept[n, 0, 1] = g01
-                    kept[n, 0, 2] = g10
-                    kept[n, 0, 3] = g11
-            samples[n, 0] = f00
-            samples[n, 1] = f01
-            samples[n, 2] = f10
-            samples[n, 3] = f11
+                    kept[0, 0, n] = g00
+                    kept[0, 1, n] = g01
+                    kept[0, 2, n] = g10
+                    kept[0, 3, n] = g11
+            else:
+                samples[n, 0] = T[F00 + i]
+                samples[n, 1] = T[F01 + i]
+                samples[n, 2] = T[F10 + i]
+                samples[n, 3] = T[F11 + i]
     if baseline:
         b = _baseline(num, den)
         for c in prange(n_chunks):
-            for n in range(c * CHUNK, min(N, (c + 1) * CHUNK)):
-                c0 = 0.0
-                c1 = 0.0
-                c2 = 0.0
-                c3 = 0.0
-                for t in range(rows):
-                    c0 += kept[n, t, 0] * b[t, 0]
-                    c1 += kept[n, t, 1] * b[t, 1]
-                    c2 += kept[n, t, 2] * b[t, 2]
-                    c3 += kept[n, t, 3] * b[t, 3]
-                samples[n, 0] -= c0
-                samples[n, 1] -= c1
-                samples[n, 2] -= c2
-                samples[n, 3] -= c3
+            lo, hi = c * CHUNK, min(N, (c + 1) * CHUNK)
+            acc = np.zeros((4, hi - lo))  # sum_t G_{n,t} b_t, added in t order for each n
+            for t in range(rows):
+                for p in range(4):
+                    bt = b[t, p]
+                    for n in range(lo, hi):
+                        acc[p, n - lo] += kept[t, p, n] * bt
+            for n in range(lo, hi):
+                for p in range(4):
+                    samples[n, p] -= acc[p, n - lo]
     return samples, returns
+
+
+# The 2-D kernel's rows (see ROW above): state, cumulative scores G, G(PO)MDP sums F,
+# return, the step's two normals and its discounted reward.
+X0, X1 = 0 * ROW, 1 * ROW
+G00, G01, G10, G11 = 2 * ROW, 3 * ROW, 4 * ROW, 5 * ROW
+F00, F01, F10, F11 = 6 * ROW, 7 * ROW, 8 * ROW, 9 * ROW
+RET2, Z0, Z1_, DR2 = 10 * ROW, 11 * ROW, 12 * ROW, 13 * ROW
+ROWS2 = 14
+
+
+@njit(cache=True, error_model="numpy")
+def _step2d(m, T, K, L, Pm, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator):
+    """One step of the chunk's m trajectories (rows of ``T``), the 2 x 2 algebra unrolled."""
+    k00, k01, k10, k11 = K[0, 0], K[0, 1], K[1, 0], K[1, 1]
+    l00, l10, l11 = L[0, 0], L[1, 0], L[1, 1]
+    p00, p01, p10, p11 = Pm[0, 0], Pm[0, 1], Pm[1, 0], Pm[1, 1]
+    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
+    b00, b01, b10, b11 = B[0, 0], B[0, 1], B[1, 0], B[1, 1]
+    q00, q01, q10, q11 = Q[0, 0], Q[0, 1], Q[1, 0], Q[1, 1]
+    r00, r01, r10, r11 = R[0, 0], R[0, 1], R[1, 0], R[1, 1]
+    for i in range(m):
+        x0, x1 = T[X0 + i], T[X1 + i]
+        m0 = k00 * x0 + k01 * x1
+        m1 = k10 * x0 + k11 * x1
+        z0, z1 = T[Z0 + i], T[Z1_ + i]
+        a0 = m0 + l00 * z0
+        a1 = m1 + (l10 * z0 + l11 * z1)
+        if clip:
+            u0 = min(max(a0, -ba), ba)
+            u1 = min(max(a1, -ba), ba)
+        else:
+            u0 = a0
+            u1 = a1
+        # (i, j) terms summed in the generic kernel's order, so results match bit for bit.
+        cost = (x0 * q00 * x0 + u0 * r00 * u0) + (x0 * q01 * x1 + u0 * r01 * u1)
+        cost = cost + (x1 * q10 * x0 + u1 * r10 * u0)
+        cost = cost + (x1 * q11 * x1 + u1 * r11 * u1)
+        dr = -0.5 * cost * disc
+        T[DR2 + i] = dr
+        T[RET2 + i] += dr
+        if score_clipped:
+            e0 = u0 - m0
+            e1 = u1 - m1
+        else:
+            e0 = a0 - m0
+            e1 = a1 - m1
+        d0 = p00 * e0 + p01 * e1
+        d1 = p10 * e0 + p11 * e1
+        g00 = T[G00 + i] + d0 * x0  # score of Section 2.3.13, summed over k <= t
+        g01 = T[G01 + i] + d0 * x1
+        g10 = T[G10 + i] + d1 * x0
+        g11 = T[G11 + i] + d1 * x1
+        T[G00 + i], T[G01 + i], T[G10 + i], T[G11 + i] = g00, g01, g10, g11
+        if not reinforce_estimator:
+            T[F00 + i] += g00 * dr
+            T[F01 + i] += g01 * dr
+            T[F10 + i] += g10 * dr
+            T[F11 + i] += g11 * dr
+        y0 = (a00 * x0 + b00 * u0) + (a01 * x1 + b01 * u1)
+        y1 = (a10 * x0 + b10 * u0) + (a11 * x1 + b11 * u1)
+        if clip:
+            T[X0 + i] = min(max(y0, -bs), bs)
+            T[X1 + i] = min(max(y1, -bs), bs)
+        else:
+            T[X0 + i] = y0
+            T[X1 + i] = y1
+
+
+@njit(cache=True)
+def _sums2d(m, T, num, den, kept, lo, t, baseline):
+    """The chunk's baseline sums at step t over its m trajectories, in index order (the
+    order of following them one by one), and with a baseline their G for pass 2."""
+    n0, n1, n2, n3 = num[0], num[1], num[2], num[3]
+    e0, e1, e2, e3 = den[0], den[1], den[2], den[3]
+    for i in range(m):
+        g00, g01, g10, g11 = T[G00 + i], T[G01 + i], T[G10 + i], T[G11 + i]
+        dr = T[DR2 + i]
+        h00 = g00 * g00
+        h01 = g01 * g01
+        h10 = g10 * g10
+        h11 = g11 * g11
+        n0 += h00 * dr
+        n1 += h01 * dr
+        n2 += h10 * dr
+        n3 += h11 * dr
+        e0 += h00
+        e1 += h01
+        e2 += h10
+        e3 += h11
+        if baseline:
+            kept[t, 0, lo + i] = g00
+            kept[t, 1, lo + i] = g01
+            kept[t, 2, lo + i] = g10
+            kept[t, 3, lo + i] = g11
+    num[0], num[1], num[2], num[3] = n0, n1, n2, n3
+    den[0], den[1], den[2], den[3] = e0, e1, e2, e3
 
 
 @njit(cache=True)
