@@ -394,7 +394,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
             for p in range(4):
                 num1[c, 0, p] += last_g[n, p] * last_g[n, p] * r
                 den1[c, 0, p] += last_g[n, p] * last_g[n, p]
-        b, _ = _baseline(num1, den1, np.zeros((1, H + 1, 4)), False)
+        b, _ = _baseline(num1, den1, np.zeros((1, H + 1, 4)), gpomdp_baseline)
         for n in range(N):
             for p in range(4):
                 samples[n, p] -= last_g[n, p] * b[0, p]
@@ -410,15 +410,18 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
         if T < H:
             for p in range(4):
                 ended[n // CHUNK, T, p] += last_g[n, p] * last_g[n, p]
-    b, suffix = _baseline(num, den, ended, True)
+    b, suffix = _baseline(num, den, ended, gpomdp_baseline)
     a = np.empty((N, 4))  # sum_{t<T} G_t b_t
+    # Pass 2 keeps no sums: False, as a variable rather than a literal, so that numba compiles
+    # _simulate_chunk (and _baseline, above) once, not once per literal.
+    no_sums = not gpomdp_baseline
     for c in prange(n_chunks):
         # Pass 2 simulates the chunk again from its streams, with weight b: the same
         # trajectories, bit for bit (it rewrites last_g, lengths and peak with the same values).
         # Cheaper than keeping every G_t of pass 1: 32 bytes a step to write and read back.
         _simulate_chunk(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, b,
                         action_bound, x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num[0],
-                        den[0], False, a, last_g, lengths, peak)
+                        den[0], no_sums, a, last_g, lengths, peak)
     for n in range(N):
         T = int(lengths[n])
         for p in range(4):
