@@ -31,8 +31,8 @@ def run_and_report(name: str, budget: int, capsys) -> dict:
 def test_every_authors_variant_is_listed(capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
-    for name in ("table-5.1-authors", "table-5.3-authors", "cartpole-baseline-authors", "table-5.4-authors",
-                 "table-5.4-authors-theta-star"):
+    for name in ("table-5.1-authors", "table-5.2-authors", "table-5.3-authors", "cartpole-baseline-authors",
+                 "table-5.4-authors", "table-5.4-authors-theta-star"):
         assert name in out
 
 

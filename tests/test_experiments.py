@@ -220,6 +220,12 @@ def test_authors_experiments_are_the_library_settings_combined():
     t53 = ex.get_experiment("table-5.3-authors").configs[0]
     assert replace(t53, n_max=500_000, statistics=None, step_when_unsafe=None) == ex.get_experiment(
         "table-5.3").config("adaptive")
+    # Table 5.2's theoretical-range rows (the range 1280 already the authors'), their step unguarded.
+    t52, t52a = ex.get_experiment("table-5.2"), ex.get_experiment("table-5.2-authors")
+    assert [c.name for c in t52a.configs] == ["gpomdp-hoeffding-delta=0.95", "gpomdp-bernstein-delta=0.95"]
+    assert [replace(c, step_when_unsafe=None) for c in t52a.configs] == [t52.config(c.name) for c in t52a.configs]
+    assert all(c.step_when_unsafe and c.theoretical_range == 1280.0 for c in t52a.configs)
+    assert t52a.rules == "authors" and t52a.thesis == {c.name: t52.thesis[c.name] for c in t52a.configs}
 
 
 def test_authors_experiment_runs_and_is_counted_their_way(root):

@@ -37,7 +37,8 @@ def tiny_experiments() -> dict:
             exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
         except ValueError:  # not defined by this version of the library
             continue
-    exps["table-5.3-authors"] = scaled(get_experiment("table-5.3-authors"), seeds=2, budget=4000)
+    for n in ("table-5.2-authors", "table-5.3-authors"):
+        exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
     for n in ("cartpole-baseline", "cartpole-baseline-authors"):
         exps[n] = scaled(get_experiment(n), seeds=2, budget=8000)
     # The doubled-pole runs start from theta = 0 (no baseline search); 16000 trajectories give the
@@ -218,9 +219,11 @@ def test_rows_carry_the_authors_columns(store):
     assert ids["table-5.4/N=4000/improvement-ratio"].authors_output == "44.76% (128/286)"
     assert ids["section-5.3/baseline-iterations"].authors_experiment == "cartpole-baseline-authors"
     assert ids["section-5.3/baseline-iterations"].authors_output == "72"
-    # The Table 5.2 theoretical-range rows: Lemma 4.3.3's range as ours, the authors' 1280 beside.
+    # The Table 5.2 theoretical-range rows: Lemma 4.3.3's range as ours, the authors' settings beside
+    # (their range 1280 and their unguarded step); ours with their range alone named in the note.
     for rid in ("table-5.2/gpomdp-hoeffding-delta=0.95", "table-5.2/gpomdp-bernstein-delta=0.95"):
-        assert ids[rid].fields["theoretical_range"] is None and ids[rid].authors_experiment == "table-5.2"
+        assert ids[rid].fields["theoretical_range"] is None and ids[rid].authors_experiment == "table-5.2-authors"
+        assert ids[rid].authors not in ("", "-") and ids[rid].authors_seeds == 2
     assert ids["table-5.2/gpomdp-bernstein-delta=0.95"].authors_output == "-10.2159 [-10.2162; -10.2155]"
 
 

@@ -402,6 +402,14 @@ def _table_5_3_authors() -> Experiment:
                       {"adaptive": _table_5_3().thesis["adaptive"]}, rules="authors")
 
 
+def _table_5_2_authors() -> Experiment:
+    t52 = _table_5_2()
+    configs = tuple(replace(c, step_when_unsafe=True) for c in t52.configs if c.theoretical_range is not None)
+    return Experiment("table-5.2-authors", "Table 5.2's two theoretical-range rows as the authors' script ran them: "
+                      "the range 1280 and the step taken even when eps >= |g| (with this range, on the first "
+                      "batch).", configs, 5, {c.name: t52.thesis[c.name] for c in configs}, rules="authors")
+
+
 def _cartpole_baseline_authors() -> Experiment:
     base = _cartpole_baseline()
     cfg = replace(base.configs[0], env=_authors_cartpole(doubled=False), update_at_target=True)
@@ -456,7 +464,8 @@ def _registry() -> dict[str, Experiment]:
                    # The cart-pole sweep's experiments.
                    *_sweep_baselines(), _cartpole_sweep(),
                    # The authors' settings.
-                   _table_5_1_authors(), _table_5_3_authors(), _cartpole_baseline_authors(), _table_5_4_authors(),
+                   _table_5_1_authors(), _table_5_2_authors(), _table_5_3_authors(), _cartpole_baseline_authors(),
+                   _table_5_4_authors(),
                    _table_5_4_authors(theta_star=True))
     registry = {e.name: e for e in experiments}
     return {name: _bind(e, registry) for name, e in registry.items()}

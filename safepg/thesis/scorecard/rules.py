@@ -115,10 +115,8 @@ NOTES: dict[str, Note] = {
         "cell within 5 points of the printed one; what is missing: the authors' other runs (one run per cell is "
         "committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False),
     "table-5.2/theoretical-range": Note(
-        "Open: {range_rows}, and the authors' own five runs give the printed value (beside). The count of "
-        "iterations hints at their first update, taken even when ε ≥ abs(g) (lqg/lqg_adabatch.py@af36577:247-257), "
-        "where ours does not move; what is missing is a run of this row with that unguarded step.", "lqg1d",
-        "Table 5.2", explains=False),
+        "Open: {range_rows}, and the authors' own five runs give the printed value (beside). What is missing is "
+        "a setting of theirs that accounts for the rest.", "lqg1d", "Table 5.2", explains=False),
     "section-5.2/theta-star": Note(
         "Reproduced with γ = 0.9, the discount the Section 5.2 runs use and the only one in the authors' code "
         "(lqgnd/lqgnd.py@92ac378:41); the printed γ = 0.95 gives {theta_printed_setting:.4f}.", "lqg2d",

@@ -117,10 +117,13 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
 
 
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
-                    variant: Experiment | None, variant_rep: Mapping[str, Any] | None) -> None:
+                    variant: Experiment | None, variant_rep: Mapping[str, Any] | None,
+                    authors: Experiment | None = None, authors_rep: Mapping[str, Any] | None = None) -> None:
     """Table 5.2 row by row. The two theoretical-range rows (Hoeffding and Bernstein without the
     empirical range) are judged on Lemma 4.3.3's range as printed (``variant``), then on the
-    authors' formula, 2 M_phi A_bar abs(A) R / (sigma^2 (1 - gamma)) = 1280, which ``exp`` runs."""
+    authors' settings: their formula for the range, 2 M_phi A_bar abs(A) R / (sigma^2 (1 - gamma))
+    = 1280, which ``exp`` runs, and their step taken even when eps >= abs(g) (``authors``,
+    ``table-5.2-authors``; without it, ``exp`` stands for the authors' settings)."""
     dec = TABLE_DECIMALS["table-5.2"]
     fmt = lambda x: num(x, dec)  # noqa: E731
     lemma = {}
@@ -136,16 +139,24 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         mean, ci = _mean_ci(r["upsilon_bar"])
         ratios.append(r["improvement_ratio"]["mean"])
         out = outputs.table_5_2(key)
-        seeds, a_cells, note_id = r["seeds"], {}, None
+        seeds, a_cells, note_id, guarded = r["seeds"], {}, None, ""
         theoretical = c.bound != "chebyshev" and not c.empirical_range and key in lemma
         if theoretical:
             vc, vr = lemma[key]
-            a_cells = _authors(exp, seeds, mean, ci, f"{fmt(mean)}{ci_text(ci, fmt)}",
-                               lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t))  # type: ignore[arg-type]
+            guarded = f"{fmt(mean)}{ci_text(ci, fmt)}"  # the authors' range, our guarded step (table-5.2)
+            ar = _report_row(authors_rep, c.name) if authors is not None else None
+            if authors is not None:
+                a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
+                a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                                   f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
+                                   lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t))  # type: ignore[arg-type]
+            else:
+                a_cells = _authors(exp, seeds, mean, ci, guarded,
+                                   lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t))  # type: ignore[arg-type]
             mean, ci = _mean_ci(vr["upsilon_bar"])
             seeds = vr["seeds"]
             b.values["range_rows"] = (f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
-                                      f"authors' 1280 {a_cells.get('authors', '-')} over "
+                                      f"authors' settings {a_cells.get('authors', '-')} over "
                                       f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
         ok = None if mean is None else intervals_overlap(ci, th["ci95"])
@@ -158,9 +169,11 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
               difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
               page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"], ours_value=mean,
               ours_ci95=ci, seeds=seeds, expected_seeds=exp.seeds,
-              authors_note="Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the "
-                           "authors' formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) = 1280 "
-                           "(lqg/lqg_adabatch.py@af36577:50-52), reproduces it.",
+              authors_note=("Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the "
+                            "authors' settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) "
+                            "= 1280 (lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
+                            f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
+                            f"their range and our guarded step (table-5.2): {guarded}.") if guarded else "",
               slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
               fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
                       "delta": c.delta, "theoretical_range": None if theoretical else c.theoretical_range,
@@ -481,7 +494,7 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
     _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps["table-5.1-printed-theta0"],
                     reps["table-5.1-printed-theta0"], exps.get("table-5.1-authors"), reps.get("table-5.1-authors"))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
-                    reps.get(range_variant or ""))
+                    reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
                names=[c.name for c in exps["table-5.2"].configs], k=PRINTED["lqg1d_step_order"], page="lqg1d",
