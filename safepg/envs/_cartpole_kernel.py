@@ -16,11 +16,12 @@ Two things need care when the time loop stops early:
   :math:`\sum_n G_{n,l}^2` counts it at every dead step l. Each chunk therefore records
   the final :math:`G^2` of trajectories that ended at step T, and the denominators get
   their running sum over T <= l.
-- Pass 2 subtracts :math:`\sum_l G_{n,l} b_l`; the dead steps contribute
-  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. For the live steps' G pass 2
-  simulates each trajectory again from the start of its stream (the same numbers, the same
-  code, so the same bits): with the step vectorised, that costs less than writing every
-  :math:`G_{n,l}` of pass 1 to memory and reading it back.
+- The baseline term :math:`\sum_l G_{n,l} b_l` of a sample: the dead steps contribute
+  :math:`G_{n,T_n} \sum_{l \ge T_n} b_l`, one suffix sum. The live steps' terms need
+  :math:`b_l`, which depends on every trajectory's step l. With G(PO)MDP's baseline, time
+  therefore runs outside, over the whole batch: once every chunk has made step l, its
+  :math:`b_l` is formed and each live trajectory adds :math:`G_{n,l} b_l`, in one pass,
+  with the terms and the order of a second pass over the trajectories.
 
 As in :mod:`safepg.envs._lqg_kernel`, trajectories are processed in fixed-size chunks in
 parallel; every chunk writes its own partial sums and the chunks are reduced in order,
@@ -88,11 +89,13 @@ def _initial_state(key, n, init_bound):
 ROW = CHUNK + 8
 X, X_DOT, BETA, BETA_DOT = 0 * ROW, 1 * ROW, 2 * ROW, 3 * ROW  # the state s
 G0, G1, G2, G3 = 4 * ROW, 5 * ROW, 6 * ROW, 7 * ROW  # the cumulative score G_t
-A0, A1, A2, A3 = 8 * ROW, 9 * ROW, 10 * ROW, 11 * ROW  # sum_t G_t w_t
+A0, A1, A2, A3 = 8 * ROW, 9 * ROW, 10 * ROW, 11 * ROW  # sum_t G_t gamma^t (G(PO)MDP's sample)
 P0, P1, P2, P3 = 12 * ROW, 13 * ROW, 14 * ROW, 15 * ROW  # max |s| so far
-Z = 16 * ROW  # this step's standard normals
-SIN, COS = 17 * ROW, 18 * ROW  # sine and cosine of this step's angles
-ROWS = 19
+B0, B1, B2, B3 = 16 * ROW, 17 * ROW, 18 * ROW, 19 * ROW  # sum_t G_t b_t (G(PO)MDP's baseline term)
+PACKED = 20  # the rows above follow their trajectory when the pack closes up
+Z = 20 * ROW  # this step's standard normals
+SIN, COS = 21 * ROW, 22 * ROW  # sine and cosine of this step's angles
+ROWS = 23
 
 
 @njit(cache=True, error_model="numpy")
@@ -147,63 +150,95 @@ def _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, w0, w1
 
 
 @njit(cache=True)
-def _simulate_chunk(lo, hi, K, sigma, inv_var, consts, key, H, init_bound, weight, action_bound,
-                    x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num, den, sums, out_a, out_g,
-                    lengths, peak):
-    r"""Simulate trajectories lo..hi-1 until they end, with their scores.
-
-    For each trajectory n and step t < T_n: the cumulative score
-    :math:`G_t = \sum_{k \le t} (a_k - \mu_k) \phi_k / \sigma^2`, and the weighted sum
-    :math:`A = \sum_{t < T} G_t \odot w_t`, with ``weight`` :math:`w_t` (H, 4): the discount
-    :math:`\gamma^t` for G(PO)MDP's sample, the baseline :math:`b_t` for its second pass.
-    Written per trajectory: ``out_a`` (A), ``out_g`` (the last :math:`G_{T-1}`), ``lengths``
-    (T) and ``peak`` (max |s| over its states, initial and final included).
-    With ``sums``: this chunk's baseline sums ``num[t] += G_t^2 disc_t``, ``den[t] += G_t^2``.
-
-    The chunk's live trajectories are kept packed, in the order of their indices (rows of
-    ``S``, above). Each step is a few loops over them: the normals (:func:`safepg.streams.draw_normals`);
-    the policy, the scores and the dynamics in one branch-free loop that the compiler
-    vectorises (:func:`_advance`); the sums over trajectories, in index order; then the
-    ended trajectories leave the pack. Every trajectory's operations are those of following
-    it alone and every sum over trajectories is formed in index order, as in the reference
-    path: the same bits, whatever the vector width (``tests/test_portable.py``).
-    """
-    m = hi - lo
-    S = np.zeros(ROWS * ROW)
-    idx = np.empty(m, dtype=np.intp)  # chunk index of each packed trajectory
-    st = np.empty(m, dtype=np.uint64)  # its stream
-    rejected = np.empty(m, dtype=np.bool_)
-    alive = np.empty(m, dtype=np.bool_)
+def _start_chunk(lo, m, key, init_bound, S, idx, st):
+    """Pack trajectories lo..lo+m-1 of the batch into a chunk's rows: initial states, peaks, streams."""
     for i in range(m):
         S[X + i], S[X_DOT + i], S[BETA + i], S[BETA_DOT + i], st[i] = _initial_state(key, lo + i, init_bound)
         for r in range(4):
             S[P0 + r * ROW + i] = abs(S[X + r * ROW + i])
         idx[i] = i
-    n = m
-    for t in range(H):
-        if n == 0:
-            break
-        draw_normals(st, S, Z, rejected, n)
-        n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, weight[t, 0],
-                           weight[t, 1], weight[t, 2], weight[t, 3], consts, x_threshold, angle_threshold,
-                           semi_implicit)
-        if sums:
-            _sums(n, S, disc[t], num[t], den[t])
-        if n_ended == 0:
+
+
+@njit(cache=True)
+def _step_chunk(n, S, st, rejected, alive, K, sigma, inv_var, score_clipped, action_bound, w, consts, x_threshold,
+                angle_threshold, semi_implicit, dt, sums, num, den):
+    """Step t of a chunk's n live trajectories: the normals (:func:`safepg.streams.draw_normals`),
+    the step (:func:`_advance`, A += G_t w), and with ``sums`` the chunk's baseline sums of the
+    step, ``num`` = sum_j G_j^2 dt and ``den`` = sum_j G_j^2; returns how many ended."""
+    draw_normals(st, S, Z, rejected, n)
+    n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, w, w, w, w, consts, x_threshold,
+                       angle_threshold, semi_implicit)
+    if sums:
+        for p in range(4):
+            num[p] = 0.0
+            den[p] = 0.0
+        _sums(n, S, dt, num, den)
+    return n_ended
+
+
+@njit(cache=True)
+def _baseline_row(t, num, den, ended, dead, b):
+    """b_t = num_t / den_t (0 where den_t = 0) as soon as every chunk has made step t: the
+    chunks' sums added in chunk order, and den_t with the final G^2 of every trajectory
+    already ended (``dead``, their running sum). Serial, in its own function: inside the
+    parallel kernel every loop here would become a parallel region of its own."""
+    for p in range(4):
+        nb = 0.0
+        db = 0.0
+        for c in range(num.shape[0]):
+            nb += num[c, p]
+            db += den[c, p]
+        for c in range(num.shape[0]):
+            dead[p] += ended[c, t, p]
+        db += dead[p]
+        b[t, p] = nb / db if db != 0.0 else 0.0
+
+
+@njit(cache=True)
+def _reinforce_baseline(num, den):
+    """REINFORCE's b = sum_c num_c / sum_c den_c (0 where the denominator is 0), the chunks in
+    order (num, den: (chunks, 1, 4))."""
+    b = np.zeros(4)
+    for p in range(4):
+        nb = 0.0
+        db = 0.0
+        for c in range(num.shape[0]):
+            nb += num[c, 0, p]
+            db += den[c, 0, p]
+        if db != 0.0:
+            b[p] = nb / db
+    return b
+
+
+@njit(cache=True)
+def _close_step(lo, n, n_ended, t, H, S, idx, st, alive, gpomdp_baseline, b, ended, out_a, out_b, out_g, lengths,
+                peak):
+    """After step t of a chunk: with G(PO)MDP's baseline, B += G_t b_t; the trajectories that
+    ended write their results (and their final G^2 to ``ended``) and leave the pack, which
+    closes up in index order. Returns the number still alive."""
+    if gpomdp_baseline:
+        for p in range(4):
+            bt = b[t, p]
+            for j in range(n):
+                S[B0 + p * ROW + j] += S[G0 + p * ROW + j] * bt
+    if n_ended == 0:
+        return n
+    rows = PACKED if gpomdp_baseline else B0 // ROW  # the B rows only matter with the baseline
+    kept = 0
+    for j in range(n):
+        if not alive[j]:
+            _finish(lo + idx[j], t + 1, S, j, out_a, out_b, out_g, lengths, peak)
+            if gpomdp_baseline and t + 1 < H:
+                for p in range(4):
+                    g = S[G0 + p * ROW + j]
+                    ended[t + 1, p] += g * g
             continue
-        kept = 0
-        for j in range(n):
-            if not alive[j]:
-                _finish(lo + idx[j], t + 1, S, j, out_a, out_g, lengths, peak)
-                continue
-            if kept != j:
-                idx[kept], st[kept] = idx[j], st[j]
-                for r in range(16):  # the rows up to Z, which the next step draws afresh
-                    S[r * ROW + kept] = S[r * ROW + j]
-            kept += 1
-        n = kept
-    for j in range(n):  # alive at the horizon
-        _finish(lo + idx[j], H, S, j, out_a, out_g, lengths, peak)
+        if kept != j:
+            idx[kept], st[kept] = idx[j], st[j]
+            for r in range(rows):
+                S[r * ROW + kept] = S[r * ROW + j]
+        kept += 1
+    return kept
 
 
 @njit(cache=True)
@@ -227,53 +262,14 @@ def _sums(n, S, dt, num, den):
 
 
 @njit(cache=True)
-def _finish(n, T, S, j, out_a, out_g, lengths, peak):
+def _finish(n, T, S, j, out_a, out_b, out_g, lengths, peak):
     """Write the results of trajectory n, packed at j, which ended after T steps."""
     for p in range(4):
         out_a[n, p] = S[A0 + p * ROW + j]
+        out_b[n, p] = S[B0 + p * ROW + j]
         out_g[n, p] = S[G0 + p * ROW + j]
         peak[n, p] = S[P0 + p * ROW + j]
     lengths[n] = T
-
-
-@njit(cache=True)
-def _baseline(num, den, ended, gpomdp_baseline):
-    """Baselines b (rows, 4) = num / den (0 where den = 0) and their suffix sums (H + 1, 4).
-
-    Serial, and in its own (non-parallel) function: inside the parallel kernel numba would
-    turn every array expression here into a parallel region with its own barrier, about a
-    thousand per call, which is slow on a busy machine. The chunks are added in order, so
-    the result does not depend on the number of threads.
-    """
-    n_chunks, rows = num.shape[0], num.shape[1]
-    nb = np.zeros((rows, 4))
-    db = np.zeros((rows, 4))
-    for c in range(n_chunks):
-        for t in range(rows):
-            for p in range(4):
-                nb[t, p] += num[c, t, p]
-                db[t, p] += den[c, t, p]
-    H = ended.shape[1] - 1
-    if gpomdp_baseline:
-        dead = np.zeros(4)  # sum of the final G^2 of the trajectories already ended at step t
-        for t in range(H):
-            for c in range(n_chunks):
-                for p in range(4):
-                    dead[p] += ended[c, t, p]
-            for p in range(4):
-                db[t, p] += dead[p]
-    b = np.zeros((rows, 4))
-    for t in range(rows):
-        for p in range(4):
-            if db[t, p] != 0.0:
-                b[t, p] = nb[t, p] / db[t, p]
-    # suffix[T] = sum_{l >= T} b_l: what a trajectory's frozen G contributes after it ended.
-    suffix = np.zeros((H + 1, 4))
-    if gpomdp_baseline:
-        for t in range(H - 1, -1, -1):
-            for p in range(4):
-                suffix[t, p] = suffix[t + 1, p] + b[t, p]
-    return b, suffix
 
 
 def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, cart_mass: float,
@@ -348,9 +344,16 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
 @njit(cache=True, parallel=True)
 def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, init_bound, gamma, action_bound,
            x_threshold, angle_threshold, score_clipped, reinforce_estimator, baseline, semi_implicit):
-    """:func:`cartpole_gradient_samples` on normalised arguments."""
+    r""":func:`cartpole_gradient_samples` on normalised arguments.
+
+    Time runs in the outer loop over the whole batch and the chunks in parallel inside it, so
+    that G(PO)MDP's baseline :math:`b_t` is known as soon as every chunk has made step t:
+    :math:`\sum_t G_{n,t} b_t` then accumulates in the same pass, with the same terms in the
+    same order as a second pass over the trajectories would add them.
+    """
     n_chunks = (N + CHUNK - 1) // CHUNK
     samples = np.empty((N, 4))
+    a = np.empty((N, 4))  # sum_{t<T} G_t b_t (G(PO)MDP with its baseline)
     last_g = np.empty((N, 4))
     lengths = np.empty(N)
     peak = np.empty((N, 4))
@@ -359,22 +362,67 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
     disc[0] = 1.0
     for t in range(H):
         disc[t + 1] = disc[t] * gamma
-    weight = np.empty((H, 4))  # G(PO)MDP's sample sums G_t gamma^t; REINFORCE's needs no sum
-    for t in range(H):
-        for p in range(4):
-            weight[t, p] = 0.0 if reinforce_estimator else disc[t]
-    num = np.zeros((n_chunks if gpomdp_baseline else 1, H, 4))
-    den = np.zeros((n_chunks if gpomdp_baseline else 1, H, 4))
     inv_var = 1.0 / (sigma * sigma)
     consts = (half, ml, cart_mass + pole_mass, pole_mass, gravity, tau)
-    # Without a baseline the sums are never touched: every chunk gets the same dummy row.
-    i_step = 1 if gpomdp_baseline else 0
+    S = np.zeros((n_chunks, ROWS * ROW))  # every chunk's packed rows
+    idx = np.empty((n_chunks, CHUNK), dtype=np.intp)
+    st = np.empty((n_chunks, CHUNK), dtype=np.uint64)
+    rejected = np.empty((n_chunks, CHUNK), dtype=np.bool_)
+    alive = np.empty((n_chunks, CHUNK), dtype=np.bool_)
+    n_live = np.empty(n_chunks, dtype=np.intp)
+    n_ended = np.zeros(n_chunks, dtype=np.intp)
+    num = np.zeros((n_chunks, 4))  # each chunk's baseline sums of the current step
+    den = np.zeros((n_chunks, 4))
+    # Final G^2 of the trajectories of each chunk that ended at step T < H (index T): after its
+    # end a trajectory's G stays in the denominators (module docstring).
+    ended = np.zeros((n_chunks, H + 1, 4))
+    dead = np.zeros(4)
+    b = np.zeros((H, 4))
     for c in prange(n_chunks):
-        i = c * i_step
-        _simulate_chunk(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, weight,
-                        action_bound, x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num[i],
-                        den[i], gpomdp_baseline, samples, last_g, lengths, peak)
-
+        n_live[c] = min(N, (c + 1) * CHUNK) - c * CHUNK
+        _start_chunk(c * CHUNK, n_live[c], key, init_bound, S[c], idx[c], st[c])
+    if gpomdp_baseline:
+        # One parallel region per step: closing step t - 1 (which needs b_{t-1}, hence every
+        # chunk's step t - 1) and making step t.
+        live = N
+        for t in range(H + 1):
+            if t > 0:
+                _baseline_row(t - 1, num, den, ended, dead, b)
+            if live == 0:  # every chunk's sums are 0 from here on: the remaining rows all the same
+                for rest in range(t, H):
+                    _baseline_row(rest, num, den, ended, dead, b)
+                break
+            for c in prange(n_chunks):
+                if t > 0 and n_live[c] > 0:
+                    n_live[c] = _close_step(c * CHUNK, n_live[c], n_ended[c], t - 1, H, S[c], idx[c], st[c],
+                                            alive[c], True, b, ended[c], samples, a, last_g, lengths, peak)
+                if t < H and n_live[c] > 0:
+                    n_ended[c] = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var,
+                                             score_clipped, action_bound, disc[t], consts, x_threshold,
+                                             angle_threshold, semi_implicit, disc[t], True, num[c], den[c])
+                else:  # a chunk whose trajectories have all ended adds nothing to the step's sums
+                    for p in range(4):
+                        num[c, p] = 0.0
+                        den[c, p] = 0.0
+            live = 0
+            for c in range(n_chunks):
+                live += n_live[c]
+    else:
+        # Without G(PO)MDP's baseline the chunks do not wait for each other: each runs its whole
+        # time loop while its rows stay in the cache.
+        w_sample = 0.0 if reinforce_estimator else 1.0  # G(PO)MDP's sample sums G_t gamma^t
+        for c in prange(n_chunks):
+            for t in range(H):
+                if n_live[c] == 0:
+                    break
+                ne = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var, score_clipped,
+                                 action_bound, w_sample * disc[t], consts, x_threshold, angle_threshold,
+                                 semi_implicit, disc[t], False, num[c], den[c])
+                n_live[c] = _close_step(c * CHUNK, n_live[c], ne, t, H, S[c], idx[c], st[c], alive[c], False, b,
+                                        ended[c], samples, a, last_g, lengths, peak)
+    for c in prange(n_chunks):
+        for j in range(n_live[c]):  # alive at the horizon
+            _finish(c * CHUNK + idx[c, j], H, S[c], j, samples, a, last_g, lengths, peak)
     if reinforce_estimator:
         ret = np.zeros(H + 1)  # the discounted return of a trajectory of length T, sum_{t<T} gamma^t
         for t in range(H):
@@ -394,34 +442,19 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
             for p in range(4):
                 num1[c, 0, p] += last_g[n, p] * last_g[n, p] * r
                 den1[c, 0, p] += last_g[n, p] * last_g[n, p]
-        b, _ = _baseline(num1, den1, np.zeros((1, H + 1, 4)), gpomdp_baseline)
+        b1 = _reinforce_baseline(num1, den1)
         for n in range(N):
             for p in range(4):
-                samples[n, p] -= last_g[n, p] * b[0, p]
+                samples[n, p] -= last_g[n, p] * b1[p]
         return samples, lengths, peak
     if not baseline:
         return samples, lengths, peak
 
-    # Final G^2 of the trajectories of each chunk that ended at step T < H (index T), in index
-    # order: after its end a trajectory's G stays in the denominators (module docstring).
-    ended = np.zeros((n_chunks, H + 1, 4))
-    for n in range(N):
-        T = int(lengths[n])
-        if T < H:
-            for p in range(4):
-                ended[n // CHUNK, T, p] += last_g[n, p] * last_g[n, p]
-    b, suffix = _baseline(num, den, ended, gpomdp_baseline)
-    a = np.empty((N, 4))  # sum_{t<T} G_t b_t
-    # Pass 2 keeps no sums: False, as a variable rather than a literal, so that numba compiles
-    # _simulate_chunk (and _baseline, above) once, not once per literal.
-    no_sums = not gpomdp_baseline
-    for c in prange(n_chunks):
-        # Pass 2 simulates the chunk again from its streams, with weight b: the same
-        # trajectories, bit for bit (it rewrites last_g, lengths and peak with the same values).
-        # Cheaper than keeping every G_t of pass 1: 32 bytes a step to write and read back.
-        _simulate_chunk(c * CHUNK, min(N, (c + 1) * CHUNK), K, sigma, inv_var, consts, key, H, init_bound, b,
-                        action_bound, x_threshold, angle_threshold, score_clipped, semi_implicit, disc, num[0],
-                        den[0], no_sums, a, last_g, lengths, peak)
+    # suffix[T] = sum_{l >= T} b_l: what a trajectory's frozen G contributes after it ended.
+    suffix = np.zeros((H + 1, 4))
+    for t in range(H - 1, -1, -1):
+        for p in range(4):
+            suffix[t, p] = suffix[t + 1, p] + b[t, p]
     for n in range(N):
         T = int(lengths[n])
         for p in range(4):
