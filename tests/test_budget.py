@@ -48,6 +48,26 @@ def test_cartpole_counts_one_normal_per_lived_step(store, monkeypatch):
     assert traj <= w.steps <= 1000 * traj and w.normals == w.steps
 
 
+def test_safety_measurements_count_the_steps_they_stored(tmp_path) -> None:
+    folder = tmp_path / budget.SAFETY_MC
+    folder.mkdir()
+
+    def store(name: str, task: str, rollouts: list[int], steps: int | None, seconds: float) -> None:
+        outcomes = {"rollouts": rollouts, **({} if steps is None else {"steps": steps})}
+        (folder / name).write_text(json.dumps({"key": json.dumps([task]), "outcomes": outcomes, "seconds": seconds}))
+
+    store("a.json", "CartPole(pole_length=2.0)", [100, 300], 70_000, 1.5)
+    store("b.json", "CartPole(pole_length=2.0)", [100], 19_000, 0.5)
+    store("c.json", "LQG(dim=2)", [200], 8_000, 0.25)
+    (cart, lqg) = sorted(budget.safety_work(tmp_path), key=lambda w: w.chapter)
+    assert (cart.trajectories, cart.steps, cart.normals, cart.uniforms, cart.seconds) == (
+        1000, 89_000, 89_000, 4000, 2.0)
+    assert lqg.normals is None and lqg.seconds == 0.25  # the LQG's random numbers are not counted
+    store("d.json", "CartPole(pole_length=2.0)", [100], None, 0.5)  # stored before steps were counted
+    cart = next(w for w in budget.safety_work(tmp_path) if w.chapter == "cartpole")
+    assert cart.steps is None and cart.normals is None and cart.trajectories == 1200
+
+
 def test_rows_floor_and_ratio() -> None:
     works = [budget.Work("a", "lqg1d", 10, 200, 200, 10, 4.0), budget.Work("b", "lqg1d", 5, 100, 100, 5, None),
              budget.Work("safety-mc", "cartpole", 8, None, None, None, 3.0)]

@@ -62,6 +62,17 @@ def test_cart_pole_pairs_use_the_kernel_with_the_same_random_numbers():
     assert np.array_equal(a, sim.rewards.sum(axis=1))
 
 
+def test_steps_lived_are_counted(outcomes):
+    # The LQG rollouts run to the horizon; the cart-pole's end when they fall, one reward a step.
+    assert outcomes.steps == 2 * ENV.horizon * outcomes.rollouts.sum()
+    env = CartPole.thesis_doubled(gamma=1.0, angle_threshold_deg=12.0)
+    thetas = np.array([[-0.9, 2.1, 3.5, 7.25], [-0.9, 2.1, 3.6, 7.25]])
+    out = safety.monte_carlo_changes(env, thetas, 1.0, looks=(300,), seed=4)
+    block_seed = int(np.random.SeedSequence([4, 0, 0]).generate_state(1)[0])
+    lengths = [env.simulate(LinearGaussianPolicy(t[None, :], 1.0), 300, block_seed).mask.sum() for t in thetas]
+    assert out.steps == sum(lengths) and 0 < out.steps < 2 * 300 * env.horizon
+
+
 def test_same_inputs_same_outcomes_and_bad_inputs_refused():
     kw = dict(updates=np.array([0, 5]), looks=(300, 600), seed=1)
     one = safety.monte_carlo_changes(ENV, THETAS, 1.0, **kw)

@@ -381,6 +381,8 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
     for c in prange(n_chunks):
         n_live[c] = min(N, (c + 1) * CHUNK) - c * CHUNK
         _start_chunk(c * CHUNK, n_live[c], key, init_bound, S[c], idx[c], st[c])
+    # The flags below are gpomdp_baseline itself, not the literals True and False: numba would
+    # compile _step_chunk and _close_step once per literal (about 2 s from empty).
     if gpomdp_baseline:
         # One parallel region per step: closing step t - 1 (which needs b_{t-1}, hence every
         # chunk's step t - 1) and making step t.
@@ -395,11 +397,13 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
             for c in prange(n_chunks):
                 if t > 0 and n_live[c] > 0:
                     n_live[c] = _close_step(c * CHUNK, n_live[c], n_ended[c], t - 1, H, S[c], idx[c], st[c],
-                                            alive[c], True, b, ended[c], samples, a, last_g, lengths, peak)
+                                            alive[c], gpomdp_baseline, b, ended[c], samples, a, last_g, lengths,
+                                            peak)
                 if t < H and n_live[c] > 0:
                     n_ended[c] = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var,
                                              score_clipped, action_bound, disc[t], consts, x_threshold,
-                                             angle_threshold, semi_implicit, disc[t], True, num[c], den[c])
+                                             angle_threshold, semi_implicit, disc[t], gpomdp_baseline, num[c],
+                                             den[c])
                 else:  # a chunk whose trajectories have all ended adds nothing to the step's sums
                     for p in range(4):
                         num[c, p] = 0.0
@@ -417,9 +421,9 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
                     break
                 ne = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var, score_clipped,
                                  action_bound, w_sample * disc[t], consts, x_threshold, angle_threshold,
-                                 semi_implicit, disc[t], False, num[c], den[c])
-                n_live[c] = _close_step(c * CHUNK, n_live[c], ne, t, H, S[c], idx[c], st[c], alive[c], False, b,
-                                        ended[c], samples, a, last_g, lengths, peak)
+                                 semi_implicit, disc[t], gpomdp_baseline, num[c], den[c])
+                n_live[c] = _close_step(c * CHUNK, n_live[c], ne, t, H, S[c], idx[c], st[c], alive[c],
+                                        gpomdp_baseline, b, ended[c], samples, a, last_g, lengths, peak)
     for c in prange(n_chunks):
         for j in range(n_live[c]):  # alive at the horizon
             _finish(c * CHUNK + idx[c, j], H, S[c], j, samples, a, last_g, lengths, peak)

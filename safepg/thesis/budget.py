@@ -41,9 +41,9 @@ SAFETY_MC = "safety-mc"
 class Work:
     """One stored computation: its counts and the wall time it took.
 
-    ``normals`` and ``uniforms`` are the random numbers the work needs (a kernel that replays
-    a trajectory draws its numbers again; that is counted in the time, not here); ``None``
-    where they are not known (the safety measurement stores no episode lengths).
+    ``normals`` and ``uniforms`` are the random numbers the work needs; ``None`` where they
+    are not known (the 2-D LQG's safety measurement, and measurements stored before their
+    step count was).
     """
 
     name: str
@@ -111,7 +111,11 @@ def sweep_work(root: Path) -> Work | None:
 
 
 def safety_work(root: Path) -> list[Work]:
-    """The stored safety measurements by chapter (rollouts and seconds; random numbers not known)."""
+    """The stored safety measurements by chapter: rollouts, the steps they lived and seconds.
+
+    On the cart-pole a rollout draws 4 uniforms and a normal per step lived; the 2-D LQG's
+    random numbers are left uncounted (``None``).
+    """
     by_chapter: dict[str, list[dict[str, Any]]] = {}
     for p in sorted((root / SAFETY_MC).glob("*.json")):
         d = json.loads(p.read_text())
@@ -121,7 +125,11 @@ def safety_work(root: Path) -> list[Work]:
     for chapter, ds in by_chapter.items():
         rollouts = sum(2 * sum(d["outcomes"]["rollouts"]) for d in ds)
         seconds = [d["seconds"] for d in ds if "seconds" in d]
-        out.append(Work(SAFETY_MC, chapter, rollouts, None, None, None, sum(seconds) if seconds else None))
+        # Measurements stored before the step count was recorded have none.
+        counted = chapter == "cartpole" and all(d["outcomes"].get("steps") for d in ds)
+        steps = sum(d["outcomes"]["steps"] for d in ds) if counted else None
+        out.append(Work(SAFETY_MC, chapter, rollouts, steps, steps, 4 * rollouts if counted else None,
+                        sum(seconds) if seconds else None))
     return out
 
 

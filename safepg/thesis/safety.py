@@ -139,6 +139,8 @@ class MonteCarloOutcomes:
         The rollout counts of the looks.
     alpha : str
         The miss probability of each update's interval over all looks.
+    steps : int
+        Trajectory-steps simulated, both policies of every update (0 where not recorded).
     """
 
     updates: np.ndarray
@@ -149,6 +151,7 @@ class MonteCarloOutcomes:
     outcome: np.ndarray
     looks: tuple[int, ...]
     alpha: str
+    steps: int = 0
 
     def counts(self) -> dict[str, Any]:
         """``updates``, ``lowered``, ``raised``, ``undetermined``, the total ``rollouts`` (both policies
@@ -164,14 +167,14 @@ class MonteCarloOutcomes:
         """JSON-ready form (:meth:`from_json` reads it back)."""
         return {"updates": self.updates.tolist(), "change": self.change.tolist(), "lower": self.lower.tolist(),
                 "upper": self.upper.tolist(), "rollouts": self.rollouts.tolist(), "outcome": self.outcome.tolist(),
-                "looks": list(self.looks), "alpha": self.alpha}
+                "looks": list(self.looks), "alpha": self.alpha, "steps": self.steps}
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> MonteCarloOutcomes:
         return cls(np.array(d["updates"], dtype=int), np.array(d["change"], dtype=float),
                    np.array(d["lower"], dtype=float), np.array(d["upper"], dtype=float),
                    np.array(d["rollouts"], dtype=int), np.array(d["outcome"], dtype=str),
-                   tuple(d["looks"]), d["alpha"])
+                   tuple(d["looks"]), d["alpha"], int(d.get("steps", 0)))
 
 
 def paired_returns(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: float, n: int,
@@ -193,8 +196,9 @@ def paired_returns(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: fl
     for theta in (theta_a, theta_b):
         th = np.asarray(theta, dtype=float)
         policy = LinearGaussianPolicy(th.reshape(getattr(env, "action_dim", getattr(env, "dim", 1)), -1), sigma)
-        if getattr(env, "gamma", None) == 1.0 and hasattr(env, "gradient_batch"):
-            out.append(np.asarray(env.gradient_batch(policy, n, seed)[1], dtype=float))
+        if _fused_returns(env):
+            # The returns alone: no baseline to form (the returns are the same either way).
+            out.append(np.asarray(env.gradient_batch(policy, n, seed, baseline=False)[1], dtype=float))
         else:
             out.append(env.simulate(policy, n, seed).discounted_returns())
     return out[0], out[1]
@@ -223,6 +227,20 @@ def _interval(d: np.ndarray, tails: str) -> tuple[float, float, float]:
     s = math.sqrt(math.fsum(((d - m) * (d - m)).tolist()) / (d.size - 1))
     h = normal_quantile(tails) * s / math.sqrt(d.size)
     return m, m - h, m + h
+
+
+def _fused_returns(env: Any) -> bool:
+    """Whether :func:`paired_returns` reads the returns off a fused ``gradient_batch``: the
+    undiscounted returns of the cart-pole, one reward per step lived."""
+    return getattr(env, "gamma", None) == 1.0 and hasattr(env, "gradient_batch")
+
+
+def rollout_steps(env: Any, returns_a: np.ndarray, returns_b: np.ndarray) -> int:
+    """Trajectory-steps lived by the rollouts of :func:`paired_returns` (for the time budget):
+    the returns themselves on the fused path, the horizon for every rollout otherwise."""
+    if _fused_returns(env):
+        return int(returns_a.sum() + returns_b.sum())
+    return int(env.horizon) * (returns_a.size + returns_b.size)
 
 
 def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.ndarray | None = None,
@@ -267,18 +285,20 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
     result = np.zeros((ks.size, 3))
     done = np.zeros(ks.size, dtype=bool)
     used = np.zeros(ks.size, dtype=int)
+    steps = 0
     for j, n in enumerate(looks):
         for i in np.flatnonzero(~done):
             k = int(ks[i])
             block_seed = int(np.random.SeedSequence([seed, k, j]).generate_state(1)[0])
             a, b = paired_returns(env, T[k], T[k + 1], sigma, n - used[i], block_seed)
+            steps += rollout_steps(env, a, b)
             diffs[i].append(b - a)
             used[i] = n
             result[i] = _interval(np.concatenate(diffs[i]), tails)
             done[i] = result[i, 1] > 0 or result[i, 2] < 0
     outcome = np.where(result[:, 2] < 0, "lowered", np.where(result[:, 1] > 0, "raised", "undetermined"))
     return MonteCarloOutcomes(ks, result[:, 0], result[:, 1], result[:, 2], used, outcome.astype(str),
-                              tuple(int(n) for n in looks), alpha)
+                              tuple(int(n) for n in looks), alpha, steps)
 
 
 def spread_updates(iterations: int, count: int) -> np.ndarray:
@@ -346,4 +366,4 @@ def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, per_run: in
                                         seed) for T in runs]
     return MonteCarloOutcomes(*(np.concatenate([getattr(p, f) for p in parts])
                                 for f in ("updates", "change", "lower", "upper", "rollouts", "outcome")),
-                              looks=tuple(looks), alpha=alpha)
+                              looks=tuple(looks), alpha=alpha, steps=sum(p.steps for p in parts))
