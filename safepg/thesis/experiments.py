@@ -406,8 +406,8 @@ def _table_5_2_authors() -> Experiment:
     t52 = _table_5_2()
     configs = tuple(replace(c, step_when_unsafe=True) for c in t52.configs if c.theoretical_range is not None)
     return Experiment("table-5.2-authors", "Table 5.2's two theoretical-range rows as the authors' script ran them: "
-                      "the range 1280 and the step taken even when eps >= |g| (with this range, on the first "
-                      "batch).", configs, 5, {c.name: t52.thesis[c.name] for c in configs}, rules="authors")
+                      "the range 1280, the step taken even when eps >= |g| (with this range, on the first batch).",
+                      configs, 5, {c.name: t52.thesis[c.name] for c in configs}, rules="authors")
 
 
 def _cartpole_baseline_authors() -> Experiment:
@@ -435,8 +435,7 @@ def _table_5_4_authors(theta_star: bool = False) -> Experiment:
                       "undiscounted return; adaptive with gamma = 0.9 and R, M_phi measured per batch in c, first N = "
                       "1000, N_min = 10, the maxima over components, unguarded steps; 'vanilla' moving only the "
                       f"largest component by 0.01 g_k; {TABLE_5_4_BUDGET} trajectories each, counted as "
-                      "plot_cartpole.m.",
-                      configs, 5, _table_5_4().thesis, "J_hat", "authors")
+                      "plot_cartpole.m.", configs, 5, _table_5_4().thesis, "J_hat", "authors")
 
 
 def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
@@ -465,8 +464,7 @@ def _registry() -> dict[str, Experiment]:
                    *_sweep_baselines(), _cartpole_sweep(),
                    # The authors' settings.
                    _table_5_1_authors(), _table_5_2_authors(), _table_5_3_authors(), _cartpole_baseline_authors(),
-                   _table_5_4_authors(),
-                   _table_5_4_authors(theta_star=True))
+                   _table_5_4_authors(), _table_5_4_authors(theta_star=True))
     registry = {e.name: e for e in experiments}
     return {name: _bind(e, registry) for name, e in registry.items()}
 
@@ -497,14 +495,8 @@ def experiment_folder(exp: Experiment | str, root: Path | None = None) -> Path:
     return (root or results_dir()) / (exp if isinstance(exp, str) else exp.name)
 
 
-def run_experiment(
-    exp: Experiment | str,
-    seeds: int | None = None,
-    budget: int | None = None,
-    jobs: int = -1,
-    root: Path | None = None,
-    progress: bool = True,
-) -> dict[str, list[LearningRecord]]:
+def run_experiment(exp: Experiment | str, seeds: int | None = None, budget: int | None = None, jobs: int = -1,
+                   root: Path | None = None, progress: bool = True) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) of ``exp`` and return all records by config name.
 
     Finished runs are loaded, never recomputed (:func:`safepg.runner.run_configs`, which
