@@ -32,6 +32,37 @@ def mean_ci95(values: Iterable[float]) -> dict[str, Any]:
     return {"mean": m, "ci95": [m - h, m + h]}
 
 
+def prediction_interval95(values: Iterable[float], runs: int = 1) -> dict[str, Any]:
+    r"""Mean over seeds and the 95% prediction interval for one new run, or for a mean of ``runs`` new runs.
+
+    .. math:: \bar x \pm t_{0.975,\,k-1}\, s \sqrt{1/n + 1/k},
+
+    with :math:`k` seeds, :math:`s` their sample standard deviation (ddof = 1) and :math:`n` =
+    ``runs``. Where :func:`mean_ci95`'s interval holds the *mean* of the process, this one holds a
+    single run of it (``runs=1``) with probability 0.95, under normal runs: the interval to judge
+    a number that the thesis printed from one run.
+
+    Returns
+    -------
+    dict
+        ``{"mean": m, "pi95": [lo, hi], "seeds": k, "runs": n}``; ``None`` ends for fewer than two
+        values (no spread to predict from).
+
+    Raises
+    ------
+    ValueError
+        If ``runs`` is not a positive integer.
+    """
+    if int(runs) != runs or runs < 1:
+        raise ValueError(f"runs must be a positive integer, got {runs!r}")
+    x = np.asarray(list(values), dtype=float)
+    m = float(x.mean()) if x.size else None
+    if x.size < 2:
+        return {"mean": m, "pi95": [None, None], "seeds": int(x.size), "runs": int(runs)}
+    h = float(t_quantile_975(x.size - 1) * x.std(ddof=1) * np.sqrt(1 / runs + 1 / x.size))
+    return {"mean": m, "pi95": [m - h, m + h], "seeds": int(x.size), "runs": int(runs)}
+
+
 @cache
 def t_quantile_975(df: int) -> float:
     """0.975 quantile of Student's t with ``df`` degrees of freedom (:func:`t_quantile` with both
