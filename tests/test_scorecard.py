@@ -94,8 +94,11 @@ def test_interval_rules_boundaries():
     assert sc.intervals_overlap([-1.0, -0.5], [-0.5, 0.0])  # touching ends overlap
     assert not sc.intervals_overlap([-1.0, -0.51], [-0.5, 0.0])
     assert sc.intervals_overlap([-9.6619, -9.6627], [-9.6626, -9.6600])  # swapped ends as printed
-    assert sc.in_widened_interval("-20.50", [-20.495, -20.40])  # widened by 0.005
-    assert not sc.in_widened_interval("-20.50", [-20.494, -20.40])
+    assert sc.in_prediction("-20.50", [-20.495, -20.40])  # widened by 0.005
+    assert not sc.in_prediction("-20.50", [-20.494, -20.40])
+    assert sc.in_prediction("72", [68.9, 71.6]) and not sc.in_prediction("72", [68.9, 71.4])
+    assert sc.in_prediction("0", None, [0.0, 0.0]) and not sc.in_prediction("0", [-1.0, 1.0], [0.0, 1e-9])
+    assert sc.in_prediction("72", None) is None  # no interval (fewer than two seeds): not judged
 
 
 def test_ratio_rule_is_five_points():
@@ -103,12 +106,7 @@ def test_ratio_rule_is_five_points():
     assert not sc.within_points(0.5501, 0.50) and not sc.within_points(0.4499, 0.50)
 
 
-def test_seed_range_and_order_rules():
-    assert sc.in_seed_range([-0.0274, -0.02745], "-0.0275")  # -0.02745 - 0.00005 reaches it
-    assert not sc.in_seed_range([-0.0274, -0.02744], "-0.0275")
-    assert sc.in_seed_range([71.0, 110.0], "72") and not sc.in_seed_range([73.0, 110.0], "72")
-    assert sc.in_seed_range([0.0, 0.0], "0") and not sc.in_seed_range([0.0, 1e-9], "0")
-    assert not sc.in_seed_range([], "72")
+def test_order_rule():
     assert sc.order_of_magnitude(1e-5) == -5 and sc.order_of_magnitude(9.99e-6) == -6
     assert sc.order_of_magnitude(6.19e-6) == -6
     with pytest.raises(ValueError, match="x must"):
@@ -116,9 +114,10 @@ def test_seed_range_and_order_rules():
 
 
 def test_every_rule_is_stated():
-    assert set(sc.RULES) >= {"closed-form", "rounded", "ci-overlap", "ci-contains", "ratio-points", "seed-range",
-                             "order", "set"}
+    assert set(sc.RULES) >= {"closed-form", "rounded", "ci-overlap", "prediction", "reading", "ratio-points", "order",
+                             "set", "curve-band"}
     assert all(len(text) > 40 for text in sc.RULES.values())
+    assert set(sc.KIND_RULE) == set(sc.KINDS) and all(len(text) > 40 for text in sc.KIND_RULE.values())
 
 
 # ------------------------------------------------------------------ statuses
@@ -128,7 +127,7 @@ def test_status_follows_rule_and_note(monkeypatch):
     b = Builder()
     b.values["why"] = "a reason"
     common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
-                  rule="rounded", page="lqg2d", heading="Table 5.3")
+                  rule="rounded", kind="one run", page="lqg2d", heading="Table 5.3")
     b.add(id="x/ok", ok=True, **common)
     b.add(id="x/explained", ok=False, **common)
     b.add(id="x/known", ok=False, **common)
@@ -147,13 +146,16 @@ def test_status_follows_rule_and_note(monkeypatch):
     assert [r.judged_on for r in b.rows] == ["ours", "ours", "ours", "ours", "", ""]
     with pytest.raises(ValueError, match="rule"):
         b.add(id="x/bad", ok=True, **{**common, "rule": "nope"})
+    with pytest.raises(ValueError, match="kind"):
+        b.add(id="x/bad", ok=True, **{**common, "kind": "a guess"})
 
 
 def test_status_judged_on_the_authors_column(monkeypatch):
     monkeypatch.setitem(sc.NOTES, "y/explained", sc.Note("Because.", "lqg1d", "Table 5.1"))
     b = Builder()
     common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
-                  rule="rounded", page="lqg2d", heading="Table 5.3", authors="1.0", authors_note="Their θ0 did it.")
+                  rule="rounded", kind="one run", page="lqg2d", heading="Table 5.3", authors="1.0",
+                  authors_note="Their θ0 did it.")
     b.add(id="y/both", ok=True, authors_ok=True, **common)  # ours first: the text's settings suffice
     b.add(id="y/authors", ok=False, authors_ok=True, **common)
     b.add(id="y/explained", ok=False, authors_ok=False, **common)

@@ -24,7 +24,7 @@ from safepg.envs.lqg import LQG
 from safepg.learning import CHECKPOINTS, LearningRecord
 from safepg.runner import RunConfig, load_configs, run_configs, stored_run
 from safepg.runner import make_env as make_core_env
-from safepg.stats import mean_ci95
+from safepg.stats import seed_summary95
 from safepg.store import OnDamaged, results_dir
 from safepg.thesis import authors
 from safepg.thesis.authors import TABLE_5_4_BUDGET, budget_average, cartpole_theta_star, strict_improvement_ratio
@@ -580,11 +580,11 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
         rows.append({
             "name": c.name, "estimator": c.estimator, "bound": c.bound,
             "empirical_range": c.empirical_range, "delta": c.delta, "sigma": c.sigma,
-            "algorithm": c.algorithm, "budget": c.budget,
-            "batch_size": c.batch_size, "alpha": c.alpha,
+            "algorithm": c.algorithm, "budget": c.budget, "batch_size": c.batch_size, "alpha": c.alpha,
             "seeds": len(recs),
-            "upsilon_bar": mean_ci95(_summary(exp, c, r)[0] for r in recs),
-            "improvement_ratio": mean_ci95(_summary(exp, c, r)[1] for r in recs),
+            "upsilon_bar": seed_summary95(_summary(exp, c, r)[0] for r in recs),
+            "improvement_ratio": seed_summary95(_summary(exp, c, r)[1] for r in recs),
+            "theta_moved": max((float(np.max(np.abs(r.theta_final - r.theta[0]))) for r in recs), default=None),
             "improvement_ratio_on": exp.performance,
             "rules": exp.rules,
             "J_at": j_at,

@@ -63,9 +63,13 @@ from safepg.thesis.scorecard.rows import (
     scorecard,
 )
 from safepg.thesis.scorecard.rules import (
+    AUTHORS_ERROR_STATUS,
     AUTHORS_STATUS,
+    FROZEN_THETA,
     GROUPS,
     JUDGED_ON,
+    KIND_RULE,
+    KINDS,
     NOTES,
     PRINTED,
     RATIO_POINTS,
@@ -73,12 +77,12 @@ from safepg.thesis.scorecard.rules import (
     STATUS_RULE,
     STATUSES,
     TABLE_DECIMALS,
+    VACUOUS_STATUS,
     Note,
     Row,
     Status,
     half_unit,
-    in_seed_range,
-    in_widened_interval,
+    in_prediction,
     intervals_overlap,
     is_slip,
     order_of_magnitude,
@@ -87,10 +91,10 @@ from safepg.thesis.scorecard.rules import (
 )
 
 __all__ = [
-    "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "GROUPS", "JUDGED_ON", "NEEDED", "NOTES", "PRINTED",
-    "RANGE_VARIANTS", "RATIO_POINTS", "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS",
-    "THEORY_LABELS",
-    "THETA0_VARIANTS", "Note", "Row", "Status", "book_link", "counts", "group_html", "half_unit", "in_seed_range",
-    "in_widened_interval", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
+    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "FROZEN_THETA", "GROUPS",
+    "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RULES",
+    "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS",
+    "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "group_html", "half_unit", "in_prediction",
+    "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
     "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",
 ]

@@ -85,7 +85,7 @@ def _theory_rows(b: Builder) -> None:
         page, heading = _theory_link(v.location)
         b.add(id=f"theory/{v.id}", group=_theory_group(v.location), quantity=THEORY_LABELS.get(v.id, v.id),
               where=v.location, thesis=expr_text(printed), ours=expr_text(derived), difference=diff, ok=ok,
-              rule="closed-form", page=page, heading=heading, thesis_tex=expr_tex(printed),
+              rule="closed-form", kind="closed form", page=page, heading=heading, thesis_tex=expr_tex(printed),
               ours_tex=expr_tex(derived), explanation="" if ok else f"Checked by: {v.method}.")
     for e in errata.errata():
         if e.kind in ("reference", "proof"):  # cross-reference typos and proof steps are not results
@@ -99,7 +99,8 @@ def _theory_rows(b: Builder) -> None:
         first = re.split(r"(?<=\.)\s", e.explanation, maxsplit=1)[0]
         b.add(id=f"theory/{e.id}", group=_theory_group(e.location), quantity=THEORY_LABELS.get(e.id, e.id),
               where=e.location, thesis=expr_text(printed), ours=expr_text(corrected), difference=diff,
-              ok=False, rule="closed-form", page="errata", heading="Errata", note_id="theory/erratum",
+              ok=False, rule="closed-form", kind="closed form", page="errata", heading="Errata",
+              note_id="theory/erratum",
               explanation=first, thesis_tex=expr_tex(printed), ours_tex=expr_tex(corrected))
     # The decimal the thesis prints for the guarantee's constant, (393 - 95 sqrt 17) / 8 >= 0.16.
     printed_coeff = sp.simplify(errata.printed_theorem_4_3_2()["improvement_star"] / theory.g**2)
@@ -108,7 +109,7 @@ def _theory_rows(b: Builder) -> None:
     b.add(id="theory/thm_4_3_2_decimal", group=GROUPS[0], quantity="decimal value of (393 - 95√17)/8",
           where="Theorem 4.3.2 (statement)", thesis=f"≥ {text}", ours=f"{value:.4f}",
           difference=signed(value - float(text), 4), ok=value >= float(text) and within_rounding(value, text),
-          rule="rounded", page="adaptive_batch", heading="Theorem 4.3.2", thesis_value=float(text),
+          rule="rounded", kind="closed form", page="adaptive_batch", heading="Theorem 4.3.2", thesis_value=float(text),
           ours_value=value,
           explanation="The decimal is right; the guarantee it multiplies lacks a factor 1/(4c) (see the errata).")
 
@@ -123,7 +124,8 @@ def _lqg_rows(b: Builder) -> None:
                                   ("section-5.1/J-star", "J(θ*)", PRINTED["lqg1d_J_star"], j1)):
         b.add(id=rid, group="Section 5.1", quantity=q + " (closed form, γ = 0.9)", where="Section 5.1",
               thesis=f"≈ {printed}", ours=f"{ours:.4f}", difference=signed(ours - float(printed), 4),
-              ok=within_rounding(ours, printed), rule="rounded", page="preliminaries", heading="task",
+              ok=within_rounding(ours, printed), rule="rounded", kind="closed form", page="preliminaries",
+              heading="task",
               thesis_value=float(printed), ours_value=ours)
     used = LQG.thesis_2d(gamma=LQG2D_GAMMA)
     printed_setting = LQG.thesis_2d()
@@ -137,8 +139,8 @@ def _lqg_rows(b: Builder) -> None:
     b.add(id="section-5.2/theta-star", group="Section 5.2", quantity="optimal parameter θ*₁₁ = θ*₂₂ "
           "(2-D LQG)", where="Section 5.2.1", thesis=f"≈ {theta_text}", ours=f"{t11:.4f}",
           difference=signed(t11 - PRINTED_THETA_STAR, 4), ok=within_rounding(t11, theta_text)
-          and float(np.abs(K[0, 1])) == 0 and float(np.abs(K[1, 0])) == 0, rule="rounded", page="lqg2d",
-          heading="setting as printed", thesis_value=PRINTED_THETA_STAR, ours_value=t11,
+          and float(np.abs(K[0, 1])) == 0 and float(np.abs(K[1, 0])) == 0, rule="rounded", kind="closed form",
+          page="lqg2d", heading="setting as printed", thesis_value=PRINTED_THETA_STAR, ours_value=t11,
           explanation=fill(NOTES["section-5.2/theta-star"].text, b.values))
     j2 = b.values["J_used"]
     j_text = repr(PRINTED_J_STAR)
@@ -146,12 +148,14 @@ def _lqg_rows(b: Builder) -> None:
     theirs = authors.lqg2d_performance(K, 1.0, LQG2D_GAMMA)
     b.add(id="section-5.2/J-star", group="Section 5.2", quantity="J(θ*) (2-D LQG)", where="Section 5.2.1",
           thesis=f"≈ {j_text}", ours=f"{j2:.3f}", difference=signed(j2 - PRINTED_J_STAR, 3),
-          ok=within_rounding(j2, j_text), rule="rounded", page="lqg2d", heading="setting as printed",
-          thesis_value=PRINTED_J_STAR, ours_value=j2, authors=f"{theirs:.5f}", authors_value=theirs,
-          authors_experiment="safepg.thesis.authors.lqg2d_performance", authors_ok=within_rounding(theirs, j_text),
-          authors_note=f"Reproduced by the authors' own J (lqgnd/lqgnd.py@92ac378:226-227), which is 16 times the "
-                       f"expectation (the integral of s0'P s0 + W over the initial-state box [-2, 2]², not its "
-                       f"mean) at γ = 0.9: {theirs:.5f} at θ* = diag({t11:.6f}), where the consistent J is {j2:.4f}.")
+          ok=within_rounding(j2, j_text), rule="rounded", kind="closed form", page="lqg2d",
+          heading="setting as printed", thesis_value=PRINTED_J_STAR, ours_value=j2, authors=f"{theirs:.5f}",
+          authors_value=theirs, authors_experiment="safepg.thesis.authors.lqg2d_performance",
+          authors_ok=within_rounding(theirs, j_text), authors_error=True,
+          authors_note=f"Reproduced only by an error in the authors' code, not by a setting: their J "
+                       f"(lqgnd/lqgnd.py@92ac378:226-227) is 16 times the expectation (the integral of s0'P s0 + W "
+                       f"over the initial-state box [-2, 2]², not its mean); at γ = 0.9 it gives {theirs:.5f} at "
+                       f"θ* = diag({t11:.6f}), where the expectation is {j2:.4f}.")
 
 
 def closed_form_rows(b: Builder) -> None:

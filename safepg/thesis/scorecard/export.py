@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from safepg.thesis.scorecard.rows import scorecard
-from safepg.thesis.scorecard.rules import GROUPS, RULES, STATUS_RULE, STATUSES, Row
+from safepg.thesis.scorecard.rules import GROUPS, KIND_RULE, RULES, STATUS_RULE, STATUSES, Row
 
 
 def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
@@ -23,7 +23,8 @@ def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
 
 
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
-CSV_COLUMNS = ("id", "group", "quantity", "where", "thesis", "ours", "difference", "status", "judged_on", "rule",
+CSV_COLUMNS = ("id", "group", "quantity", "where", "kind", "thesis", "ours", "difference", "status", "judged_on",
+               "rule", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
                "explanation", "link", "thesis_value", "ours_value", "ours_ci95_low", "ours_ci95_high", "seeds",
                "authors", "authors_value", "authors_ci95_low", "authors_ci95_high", "authors_seeds",
                "authors_experiment", "authors_output", "authors_output_value", "authors_output_source", "slip")
@@ -36,7 +37,9 @@ def _flat(r: Row) -> dict[str, Any]:
     d = {k: getattr(r, k) for k in CSV_COLUMNS if hasattr(r, k)}
     lo, hi = (r.ours_ci95 or [None, None])
     a_lo, a_hi = (r.authors_ci95 or [None, None])
-    d.update(ours_ci95_low=lo, ours_ci95_high=hi, authors_ci95_low=a_lo, authors_ci95_high=a_hi)
+    j_lo, j_hi = (r.judged_interval or [None, None])
+    d.update(ours_ci95_low=lo, ours_ci95_high=hi, authors_ci95_low=a_lo, authors_ci95_high=a_hi,
+             judged_interval_low=j_lo, judged_interval_high=j_hi)
     return d
 
 
@@ -70,7 +73,7 @@ def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **k
     out_dir = Path(path_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written: dict[str, Path] = {}
-    meta = {"rules": RULES, "status_rule": STATUS_RULE, "counts": counts(rows)}
+    meta = {"kinds": KIND_RULE, "rules": RULES, "status_rule": STATUS_RULE, "counts": counts(rows)}
     p = out_dir / "scorecard.json"
     p.write_text(json.dumps({**meta, "rows": [r.to_dict() for r in rows]}, indent=1, ensure_ascii=False) + "\n",
                  encoding="utf-8")
@@ -82,8 +85,9 @@ def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **k
         sel = [r for r in rows if r.id.startswith(prefix)]
         keys = list(dict.fromkeys(k for r in sel for k in r.fields))
         flat = [{**r.fields, **_flat(r)} for r in sel]
-        cols = [*keys, "quantity", "thesis", "ours", "ours_ci95_low", "ours_ci95_high", "difference", "status",
-                "judged_on", "thesis_value", "ours_value", "seeds", "authors", "authors_value", "authors_ci95_low",
+        cols = [*keys, "quantity", "kind", "thesis", "ours", "ours_ci95_low", "ours_ci95_high", "difference", "status",
+                "judged_on", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
+                "thesis_value", "ours_value", "seeds", "authors", "authors_value", "authors_ci95_low",
                 "authors_ci95_high", "authors_seeds", "authors_experiment", "authors_output", "authors_output_value",
                 "authors_output_source", "slip", "id", "link"]
         p = out_dir / f"{stem}.csv"

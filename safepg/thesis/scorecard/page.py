@@ -12,7 +12,7 @@ from importlib import resources
 from safepg.thesis.authors import REPOSITORY
 from safepg.thesis.scorecard.export import counts
 from safepg.thesis.scorecard.links import heading_id
-from safepg.thesis.scorecard.rules import AUTHORS_STATUS, STATUSES, Row
+from safepg.thesis.scorecard.rules import AUTHORS_ERROR_STATUS, AUTHORS_STATUS, STATUSES, VACUOUS_STATUS, Row
 
 
 # The tables scroll inside their own box (never the page) with "scroll shadows": a shadow
@@ -27,8 +27,8 @@ def _style_sheet() -> str:
     return f"\n<style>\n{css}</style>\n"
 
 
-_STATUS_CLASS = {"reproduced": "sc-reproduced", AUTHORS_STATUS: "sc-authors", "differs (explained)": "sc-explained",
-                 "open": "sc-open"}
+_STATUS_CLASS = {"reproduced": "sc-reproduced", AUTHORS_STATUS: "sc-authors", AUTHORS_ERROR_STATUS: "sc-error",
+                 VACUOUS_STATUS: "sc-vacuous", "differs (explained)": "sc-explained", "open": "sc-open"}
 _HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
          "columns).</p>")
 
@@ -92,6 +92,14 @@ def _source_link(source: str) -> str:
     return f'<a class="sc-src" href="{html.escape(url)}" title="{html.escape(source)}">{label}</a>'
 
 
+def _judged_html(r: Row) -> str:
+    """What the status was judged on: the column and its interval (nothing for a closed form)."""
+    if not r.judged_interval_text:
+        return ""
+    on = "ours, authors' settings" if r.judged_on == "authors' settings" else "ours"
+    return f'<span class="sc-detail sc-on">on {html.escape(on)}: {html.escape(r.judged_interval_text)}</span>'
+
+
 def _authors_cells(r: Row) -> str:
     judged = " sc-judged" if r.judged_on == "authors' settings" else ""
     ours = f'<td class="sc-num{judged}">{_split(r.authors or "")}</td>'
@@ -103,8 +111,9 @@ def _authors_cells(r: Row) -> str:
 def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
     """The rows of one group as an HTML table that scrolls inside its own box.
 
-    Each row carries ``data-id``, ``data-status``, ``data-judged-on``, ``data-thesis``, ``data-ours``
-    and ``data-authors`` (the plain texts, also for closed forms shown as typeset math); its
+    Each row carries ``data-id``, ``data-status``, ``data-kind``, ``data-judged-on``, ``data-thesis``,
+    ``data-ours`` and ``data-authors`` (the plain texts, also for closed forms shown as typeset math);
+    the result's cell names its kind, the status's cell the interval it was judged on; its
     explanation, if any, is the line below it. A group with rows run under the authors'
     settings or with the authors' outputs has those two columns too; the cell a status was
     judged on is marked.
@@ -123,10 +132,12 @@ def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
             ours = ours.replace('<td class="', '<td class="sc-judged ', 1)
         body.append(
             f'<tr class="sc-row" data-id="{html.escape(r.id)}" data-status="{html.escape(r.status)}" '
-            f'data-judged-on="{html.escape(r.judged_on)}" data-thesis="{html.escape(r.thesis)}" '
-            f'data-ours="{html.escape(r.ours)}" data-authors="{html.escape(r.authors)}">'
-            f'<td class="sc-result">{html.escape(r.quantity)}<span class="sc-detail">{html.escape(r.where)}</span></td>'
-            f"<td>{_status_html(r.status)}</td>{_cell(r.thesis, r.thesis_tex)}{ours}"
+            f'data-kind="{html.escape(r.kind)}" data-judged-on="{html.escape(r.judged_on)}" '
+            f'data-thesis="{html.escape(r.thesis)}" data-ours="{html.escape(r.ours)}" '
+            f'data-authors="{html.escape(r.authors)}">'
+            f'<td class="sc-result">{html.escape(r.quantity)}'
+            f'<span class="sc-detail">{html.escape(r.where)} · {html.escape(r.kind)}</span></td>'
+            f"<td>{_status_html(r.status)}{_judged_html(r)}</td>{_cell(r.thesis, r.thesis_tex)}{ours}"
             f'<td class="sc-num">{html.escape(r.difference)}</td>{_authors_cells(r) if wide else ""}'
             f'<td><a class="sc-link" href="{html.escape(r.link)}">{html.escape(_link_label(r.link))}</a></td></tr>')
         if r.explanation:

@@ -1,8 +1,8 @@
 """What the scorecard compares and how it judges: statuses, groups, printed values, rules, notes, rows.
 
-:data:`PRINTED` holds the printed values no other module records; :data:`RULES` states
-each status rule, and the functions below (:func:`within_rounding`, :func:`intervals_overlap`,
-:func:`in_widened_interval`, :func:`within_points`, :func:`in_seed_range`,
+:data:`PRINTED` holds the printed values no other module records; :data:`KIND_RULE` states how
+each kind of printed number is judged and :data:`RULES` each status rule; the functions below
+(:func:`within_rounding`, :func:`intervals_overlap`, :func:`in_prediction`, :func:`within_points`,
 :func:`order_of_magnitude`) apply them; :data:`NOTES` keeps the chapters' explanations of the
 rows that differ; :class:`Row` is one row of the scorecard.
 """
@@ -21,11 +21,49 @@ import numpy as np
 #: same rule, on our runs under the authors' settings: what their code ran where the text says
 #: something else or nothing.
 AUTHORS_STATUS = "reproduced only with the authors' unprinted settings"
-Status = Literal["reproduced", "reproduced only with the authors' unprinted settings", "differs (explained)", "open"]
-#: The statuses, in the order the page lists them.
-STATUSES: tuple[Status, ...] = ("reproduced", AUTHORS_STATUS, "differs (explained)", "open")
+#: The status of a row whose printed number is reproduced only by an error in the authors' code (their
+#: 2-D J, 16 times the expectation): their number explained, not the thesis's claim confirmed.
+AUTHORS_ERROR_STATUS = "reproduced only through an error in the authors' code"
+#: The status of a row whose rule holds on a run that could not have done otherwise: an improvement
+#: ratio of a run whose theta does not move (consecutive batch means then differ by noise alone, so any
+#: such run scores about 50%, or 100% when no update is taken). The agreement carries no information.
+VACUOUS_STATUS = "agrees, but carries no information"
+Status = Literal["reproduced", "reproduced only with the authors' unprinted settings",
+                 "reproduced only through an error in the authors' code", "agrees, but carries no information",
+                 "differs (explained)", "open"]
+#: The statuses, in the order the page lists them: the two that reproduce the printed number, the two
+#: counted apart (agreement through an error of the authors' code, agreement without information),
+#: then the two that do not reproduce it.
+STATUSES: tuple[Status, ...] = ("reproduced", AUTHORS_STATUS, AUTHORS_ERROR_STATUS, VACUOUS_STATUS,
+                                "differs (explained)", "open")
 #: The columns a status can be judged on (:attr:`Row.judged_on`).
 JUDGED_ON = ("ours", "authors' settings")
+#: A run whose every component of theta moves by less than this over the whole run is frozen: its
+#: improvement ratio carries no information (:data:`VACUOUS_STATUS`).
+FROZEN_THETA = 1e-6
+
+#: What kind of number a row compares, which decides the interval it is judged on (:data:`KIND_RULE`).
+Kind = Literal["closed form", "one run", "mean of runs", "read off a figure", "whole curve", "statement"]
+KINDS: tuple[Kind, ...] = ("closed form", "one run", "mean of runs", "read off a figure", "whole curve", "statement")
+#: How each kind of printed number is judged, as stated on the page.
+KIND_RULE: dict[str, str] = {
+    "closed form": "A formula or a number that follows from the task alone: judged exactly, or at the rounding "
+                   "of its last printed digit.",
+    "one run": "A number printed from one run of the authors (Table 5.1's cells, Tables 5.3 and 5.4, the 2-D runs' "
+               "final parameters and ratios, the baseline's iteration count): judged against our 95% prediction "
+               "interval for one run, mean ± t(0.975, k-1)·s·√(1 + 1/k) over our k seeds (the seed count is in "
+               "the row). The interval of our mean would reject single runs that our own seeds produce routinely.",
+    "mean of runs": "A number printed as a mean over runs with its interval (Table 5.2): judged against the 95% "
+                    "interval of our mean over seeds: two estimates of the same mean.",
+    "read off a figure": "A number the text reads off a figure (\"N ≈ 500\", \"of the order of 1e-6\"): judged at "
+                         "the reading precision the row states, against our prediction interval for one run where "
+                         "the figure shows one run.",
+    "whole curve": "An authors' curve from their raw output: the share of it, at their x-values in the plotted "
+                   "range, that lies inside our pointwise 95% prediction band for the kind of curve they plotted "
+                   "(one run, or a mean of n runs: mean ± t·s·√(1/n + 1/k)).",
+    "statement": "A claim about every configuration or every update (\"an improvement ratio of 1 ... also with "
+                 "large values of delta\", \"never updates beta\"): judged by its own rule on all our runs.",
+}
 
 #: Groups of rows, in the order of the thesis (and of the page).
 GROUPS = ("Chapters 3-4 and Appendix A", "Appendix B", "Section 5.1", "Section 5.2", "Section 5.3")
@@ -69,17 +107,19 @@ RULES: dict[str, str] = {
                "digit (-0.59 covers -0.595 to -0.585; a printed 0 must be exactly 0).",
     "ci-overlap": "Table 5.2 (a mean over 5 runs with its 95% interval): reproduced when our 95% interval over "
                   "5 seeds overlaps the printed one (two estimates of the same mean).",
-    "ci-contains": "Tables 5.3 and 5.4, average performance (a 5-run mean printed without interval): "
-                   "reproduced when the printed value lies in our 95% interval over seeds, widened by half a "
-                   "unit of its last printed digit.",
-    "ratio-points": f"Improvement ratios: reproduced when |ours - thesis| <= {RATIO_POINTS:g} percentage points "
-                    "(our ratio is the mean over seeds).",
-    "seed-range": "Values from one run (final parameters, iteration counts, batch sizes read off a figure): "
-                  "reproduced when the printed value lies within the range of our seeds, widened by half a "
-                  "unit of its last printed digit.",
+    "prediction": "A number from one run: reproduced when the printed value lies in our 95% prediction interval "
+                  "for one run, mean ± t(0.975, k-1)·s·√(1 + 1/k) over our k seeds, widened by half a unit of its "
+                  "last printed digit (a printed 0 must be exactly 0 in every seed).",
+    "reading": "A number read off a figure of one run (\"≈ 500\"): reproduced when the printed value, give or take "
+               "the reading precision the row states (half a unit of its last significant digit), meets our 95% "
+               "prediction interval for one run.",
+    "ratio-points": f"An improvement ratio claimed of every configuration: reproduced when |ours - thesis| <= "
+                    f"{RATIO_POINTS:g} percentage points for the lowest of them.",
     "order": "\"Of the order of 10^k\": reproduced when the order of magnitude of our median, "
              "10^floor(log10 x), is 10^k for every configuration.",
     "set": "A set of components: reproduced when ours is the printed one.",
+    "curve-band": "A whole curve: reproduced when at least 90% of the authors' curve, at their x-values in the "
+                  "plotted range, lies in our pointwise 95% prediction band.",
 }
 
 #: Which column a status is judged on, and what a row that fails its rule means.
@@ -88,7 +128,12 @@ STATUS_RULE = ("A row is judged first on \"ours\": our runs as the thesis's text
                "there. Otherwise, when the row has \"ours, authors' settings\" (our runs with what the authors' code "
                "ran where the text says something else or nothing: their starting point, discount, constants, "
                "counting or task), the same rule is applied to that column, and the row is \"" + AUTHORS_STATUS +
-               "\" when it holds there; the row names the setting that did it. A row that fails on both is "
+               "\" when it holds there; the row names the setting that did it. Where the authors' column holds only "
+               "through an error of their code (their 2-D J, 16 times the expectation), the row is \"" +
+               AUTHORS_ERROR_STATUS + "\". A rule that holds on a run that could not have done otherwise (an "
+               "improvement ratio of a run whose θ moves by less than " + f"{FROZEN_THETA:g}" + " in every "
+               "component: its consecutive batch means differ by noise alone) does not count: that column is "
+               "\"" + VACUOUS_STATUS + "\" unless the other one holds on a run that moved. A row that fails on both is "
                "\"differs (explained)\" when the chapter that discusses it explains the gap (the one-sentence "
                "explanation is in the row, with a link), and \"open\" otherwise, with a sentence saying what "
                "evidence is missing. \"Authors' output\" is the authors' own raw output recomputed with their "
@@ -111,9 +156,9 @@ class Note:
 #: ``{...}`` fields are filled from the measured values (see :func:`safepg.thesis.scorecard.text.fill`).
 NOTES: dict[str, Note] = {
     "table-5.1/": Note(
-        "Open: neither from the printed θ0 = {t51_theta0} nor from the authors' θ0 = {t51_authors_theta0} is this "
-        "cell within 5 points of the printed one; what is missing: the authors' other runs (one run per cell is "
-        "committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False),
+        "Open: neither from the printed θ0 = {t51_theta0} nor from the authors' θ0 = {t51_authors_theta0} does our "
+        "prediction interval for one run hold the printed value; what is missing: the authors' other runs (one run "
+        "per cell is committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False),
     "table-5.2/theoretical-range": Note(
         "Open: {range_rows}, and the authors' own five runs give the printed value (beside). What is missing is "
         "a setting of theirs that accounts for the rest.", "lqg1d", "Table 5.2", explains=False),
@@ -215,6 +260,16 @@ class Row:
         ``path@commit`` of the authors' file(s) behind ``authors_output``.
     slip : bool
         The printed value is neither the rounding nor the truncation of the authors' output.
+    kind : one of :data:`KINDS`
+        What kind of printed number this is (:data:`KIND_RULE`).
+    judged_interval : list of float or None
+        The interval the status was judged on (on the column ``judged_on``), in the units of
+        ``ours_value``; None for rules without one.
+    judged_interval_text : str
+        That interval as the page shows it, with what it is ("95% prediction interval for one run,
+        5 seeds").
+    judged_seeds : int or None
+        The seeds behind the judged column.
     """
 
     id: str
@@ -245,6 +300,10 @@ class Row:
     authors_output_value: float | None = None
     authors_output_source: str = ""
     slip: bool = False
+    kind: str = "closed form"
+    judged_interval: list[float] | None = None
+    judged_interval_text: str = ""
+    judged_seeds: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -297,27 +356,23 @@ def intervals_overlap(a: Sequence[float], b: Sequence[float]) -> bool:
     return lo_a <= hi_b and lo_b <= hi_a
 
 
-def in_widened_interval(printed: str, ci: Sequence[float]) -> bool:
-    """Rule ``"ci-contains"``: the printed value in our interval widened by half its last digit."""
-    lo, hi = sorted(ci)
+def in_prediction(printed: str, pi: Sequence[float | None] | None, values: Sequence[float] = ()) -> bool | None:
+    """Rule ``"prediction"``: the printed value in our 95% prediction interval for one run, widened by
+    half a unit of its last digit. A printed 0 must be exactly 0 in every seed (``values``). None when
+    there is no interval (fewer than two seeds)."""
+    value = float(printed)
+    if value == 0 and len(values):
+        return bool(np.all(np.asarray(values) == 0))
+    if not pi or pi[0] is None or pi[1] is None:
+        return None
+    lo, hi = sorted((float(pi[0]), float(pi[1])))
     h = half_unit(printed)
-    return lo - h <= float(printed) <= hi + h
+    return lo - h <= value <= hi + h
 
 
 def within_points(ours: float, thesis: float, points: float = RATIO_POINTS) -> bool:
     """Rule ``"ratio-points"``: two ratios in [0, 1] within ``points`` percentage points."""
     return abs(ours - thesis) * 100 <= points + 1e-9
-
-
-def in_seed_range(values: Sequence[float], printed: str) -> bool:
-    """Rule ``"seed-range"``: the printed value within [min, max] of our seeds, widened."""
-    if len(values) == 0:
-        return False
-    value = float(printed)
-    if value == 0:
-        return bool(np.all(np.asarray(values) == 0))
-    h = half_unit(printed)
-    return min(values) - h <= value <= max(values) + h
 
 
 def is_slip(output: float, printed: str) -> bool:

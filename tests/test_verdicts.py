@@ -1,0 +1,130 @@
+"""The statistics of the scorecard's verdicts: one run judged as one run, vacuous agreement named, an
+agreement through an error of the authors' code counted apart, and every row's kind and judged interval
+in the files.
+
+Synthetic rows only (no store): each rule is shown to pass and to fail.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy import stats as scipy_stats
+
+from safepg.stats import mean_ci95, prediction_interval95, seed_summary95
+from safepg.thesis import scorecard as sc
+from safepg.thesis.scorecard.builder import Builder
+
+
+# ------------------------------------------------------------------ the prediction interval
+@pytest.mark.parametrize("k", [2, 3, 5, 30])
+@pytest.mark.parametrize("runs", [1, 5])
+def test_prediction_interval_is_the_student_t_formula(k, runs):
+    x = np.random.default_rng(k).normal(3.0, 2.0, k)
+    got = prediction_interval95(x, runs=runs)
+    h = scipy_stats.t.ppf(0.975, k - 1) * x.std(ddof=1) * math.sqrt(1 / runs + 1 / k)
+    assert got["mean"] == pytest.approx(x.mean(), rel=1e-14)
+    assert got["pi95"] == pytest.approx([x.mean() - h, x.mean() + h], rel=1e-10)
+    assert got["seeds"] == k and got["runs"] == runs
+
+
+def test_prediction_interval_is_wider_than_the_mean_interval_by_sqrt_k_plus_1():
+    x = [70.0, 71.0, 70.0, 71.0, 71.0]  # the cart-pole baseline's iteration counts, five seeds
+    ci, pi = mean_ci95(x)["ci95"], prediction_interval95(x)["pi95"]
+    assert (pi[1] - pi[0]) == pytest.approx((ci[1] - ci[0]) * math.sqrt(len(x) + 1), rel=1e-12)
+    # The interval of the mean rejects the printed 72; one run of the same process reaches it.
+    assert not sc.in_prediction("72", ci) and sc.in_prediction("72", pi)
+    assert seed_summary95(x) == {**mean_ci95(x), "pi95": pi}
+
+
+def test_prediction_interval_covers_one_new_run_95_percent_of_the_time():
+    # 4000 experiments of 5 seeds and one new run from the same normal process: the new run lies in
+    # the interval with probability 0.95 exactly; 4000 draws put the share within 0.015 (4.4 sd).
+    rng = np.random.default_rng(7)
+    draws = rng.normal(0.0, 1.0, (4000, 6))
+    hits = 0
+    for row in draws:
+        lo, hi = prediction_interval95(row[:5])["pi95"]
+        hits += lo <= row[5] <= hi
+    assert abs(hits / 4000 - 0.95) < 0.015
+
+
+def test_prediction_interval_needs_two_seeds_and_a_run_count():
+    assert prediction_interval95([1.0])["pi95"] == [None, None]
+    assert prediction_interval95([])["mean"] is None
+    with pytest.raises(ValueError, match="runs must"):
+        prediction_interval95([1.0, 2.0], runs=0)
+
+
+# ------------------------------------------------------------------ statuses
+COMMON = dict(group="Section 5.3", quantity="q", where="Table 5.4", thesis="53.01%", ours="48.64%",
+              difference="-4.37 points", rule="prediction", kind="one run", page="cartpole", heading="Table 5.4")
+FROZEN = "θ moved by at most 3.0e-07 over the run: the ratio carries no information."
+
+
+def test_single_run_inside_and_outside_the_prediction_interval():
+    b = Builder()
+    inside, outside = [41.8, 55.4], [41.8, 52.9]
+    b.add(id="r/inside", ok=sc.in_prediction("53.01", inside), interval=inside, interval_text="[41.8%; 55.4%]",
+          seeds=5, **COMMON)
+    b.add(id="r/outside", ok=sc.in_prediction("53.01", outside), interval=outside, interval_text="[41.8%; 52.9%]",
+          seeds=5, **COMMON)
+    assert [r.status for r in b.rows] == ["reproduced", "open"]
+    assert b.rows[0].judged_interval == inside and b.rows[0].judged_seeds == 5 and b.rows[0].kind == "one run"
+
+
+def test_a_vacuous_ratio_is_not_reproduced():
+    b = Builder()
+    b.add(id="v/ours", ok=True, vacuous=FROZEN, **COMMON)
+    # The authors' column moved and holds: the row is judged there, not on the frozen run.
+    b.add(id="v/authors", ok=True, vacuous=FROZEN, authors_ok=True, authors="52.6%", authors_seeds=5,
+          authors_note="Their settings move θ.", authors_interval=[40.0, 60.0], authors_interval_text="[40%; 60%]",
+          **COMMON)
+    # Both columns frozen: vacuous, judged on the authors' column where only it holds.
+    b.add(id="v/both", ok=False, authors_ok=True, authors_vacuous=FROZEN, authors="50%", **COMMON)
+    b.add(id="v/moved", ok=True, vacuous="", **COMMON)
+    got = {r.id: r for r in b.rows}
+    assert got["v/ours"].status == sc.VACUOUS_STATUS and got["v/ours"].explanation.startswith("θ moved by")
+    assert got["v/authors"].status == sc.AUTHORS_STATUS and got["v/authors"].judged_on == "authors' settings"
+    assert got["v/authors"].judged_interval == [40.0, 60.0] and got["v/authors"].judged_seeds == 5
+    assert got["v/both"].status == sc.VACUOUS_STATUS and got["v/both"].judged_on == "authors' settings"
+    assert got["v/moved"].status == "reproduced"
+    assert sc.counts(b.rows)["all"]["reproduced"] == 1 and sc.counts(b.rows)["all"][sc.VACUOUS_STATUS] == 2
+
+
+def test_agreement_through_an_error_of_the_authors_code_is_counted_apart():
+    b = Builder()
+    common = {**COMMON, "rule": "rounded", "kind": "closed form", "thesis": "≈ -422.616"}
+    b.add(id="e/error", ok=False, authors_ok=True, authors_error=True, authors="-422.61600",
+          authors_note="Their J is 16 times the expectation.", **common)
+    b.add(id="e/setting", ok=False, authors_ok=True, authors="-422.61600", authors_note="A setting.", **common)
+    assert [r.status for r in b.rows] == [sc.AUTHORS_ERROR_STATUS, sc.AUTHORS_STATUS]
+    assert "16 times" in b.rows[0].explanation
+    c = sc.counts(b.rows)["all"]
+    assert c[sc.AUTHORS_ERROR_STATUS] == 1 and c[sc.AUTHORS_STATUS] == 1 and list(c) == list(sc.STATUSES)
+
+
+def test_the_status_rule_names_the_new_statuses():
+    assert sc.VACUOUS_STATUS in sc.STATUS_RULE and sc.AUTHORS_ERROR_STATUS in sc.STATUS_RULE
+    assert sc.STATUSES.index(sc.VACUOUS_STATUS) < sc.STATUSES.index("differs (explained)")
+
+
+def test_kind_and_judged_interval_reach_the_files_and_the_page(tmp_path):
+    b = Builder()
+    b.add(id="table-5.4/adaptive/improvement-ratio", ok=True, vacuous=FROZEN, interval=[41.8, 55.4],
+          interval_text="[41.8%; 55.4%]: 95% prediction interval for one run, 5 seeds", seeds=5, **COMMON)
+    files = sc.write_scorecard(tmp_path, b.rows)
+    row = json.loads(files["scorecard.json"].read_text())["rows"][0]
+    assert row["kind"] == "one run" and row["judged_interval"] == [41.8, 55.4] and row["judged_seeds"] == 5
+    csv_row = sc.read_csv(files["scorecard.csv"])[0]
+    assert csv_row["kind"] == "one run" and float(csv_row["judged_interval_low"]) == 41.8
+    assert csv_row["judged_seeds"] == "5" and csv_row["status"] == sc.VACUOUS_STATUS
+    table = sc.read_csv(files["table-5.4.csv"])[0]
+    assert table["judged_interval_text"].startswith("[41.8%; 55.4%]")
+    assert sc.read_scorecard_json(files["scorecard.json"]) == b.rows
+    page = sc.group_html(b.rows, "Section 5.3") + sc.summary_html(b.rows)
+    assert 'data-kind="one run"' in page and "95% prediction interval for one run, 5 seeds" in page
+    assert 'class="sc-status sc-vacuous"' in page
