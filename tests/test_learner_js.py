@@ -37,14 +37,21 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.learning import adaptive_pg
+from safepg.learning import adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
 from safepg.streams import batch_key, trajectory_draws
-from safepg.thesis.explorers.live_learner import task_data
+from safepg.thesis.explorers.live_learner import (
+    live_batch_size_explorer,
+    run_summary,
+    still_tolerance,
+    summary_text,
+    task_data,
+)
 
 NODE = shutil.which("node")
 # Node requires it by path: the file as the package ships it.
 LEARNER = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
+PAGE = LEARNER.with_name("live_page.js")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 RTOL = 1e-12
 
@@ -113,6 +120,21 @@ if (req.normals) {
   const r = new L.Rng(req.normals.seed, 0), buf = new Float64Array(req.normals.n);
   r.fillNormal(buf, 0, buf.length);
   fs.writeFileSync(req.normals.out, Buffer.from(buf.buffer));
+}
+if (req.page) {
+  // The page half (static/live_page.js) on whole records: safepg's (rec) or the JavaScript learner's (cfg).
+  const vm = require("vm"), ctx = {};
+  vm.createContext(ctx);
+  vm.runInContext(fs.readFileSync(req.page.src, "utf8"), ctx);
+  out.page = req.page.cases.map(q => {
+    const runs = {};
+    for (const [name, r] of Object.entries(q.runs)) {
+      const run = r.cfg ? new L.Run(r.cfg, task).finish() : null, rec = run ? run.rec : r.rec;
+      runs[name] = Object.assign({}, rec, {used: rec.batchSize.reduce((a, b) => a + b, 0), done: true,
+                                            diverged: run ? run.diverged : false, ms: 0});
+    }
+    return ctx.safepgLiveResult(q.p, {done: true, worker: false, elapsed: 0, runs: runs}, req.page.data);
+  });
 }
 process.stdout.write(JSON.stringify(out));
 """
@@ -255,6 +277,98 @@ def test_whole_run_with_safepgs_random_numbers(bound, er, estimator, tmp_path):
     np.testing.assert_allclose(js["eps"], py.eps, rtol=1e-10)
     np.testing.assert_allclose(js["Jhat"], py.J_hat, rtol=1e-12)
     np.testing.assert_allclose(js["J"], py.J, rtol=1e-10)
+
+
+def page_params(**over: Any) -> dict[str, Any]:
+    """The controls as the page reads them (sliders as numbers); defaults but a 10^4 budget."""
+    ex = live_batch_size_explorer()
+    p = {**ex.defaults(), "budget": "10000", **over}
+    return {k: float(v) if k in ("delta", "sigma", "seed") else v for k, v in p.items()}
+
+
+def python_runs(p: dict[str, Any]) -> dict[str, Any]:
+    """The records the kernel twin (live_learner.compute_py) makes for the controls p."""
+    env, bound = LQG.thesis_1d(), p["bound"]
+    common = dict(estimator=p["estimator"], baseline=p["baseline"] == "on", budget=int(p["budget"]),
+                  score_action=p["score"])
+    recs = {"adaptive": adaptive_pg(env, 0.0, p["sigma"], bound=bound.replace("-er", ""), delta=p["delta"],
+                                    empirical_range=bound.endswith("-er"), rng=np.random.default_rng(int(p["seed"])),
+                                    **common)}
+    if p["vanilla_n"] != "off":
+        recs["vanilla"] = vanilla_pg(env, 0.0, p["sigma"], batch_size=int(p["vanilla_n"]),
+                                     alpha=float(p["vanilla_alpha"]), stop_on_divergence=True,
+                                     rng=np.random.default_rng([int(p["seed"]), 1]), **common)
+    return recs
+
+
+def as_page_record(rec: Any) -> dict[str, Any]:
+    """A safepg record as the page holds it (the worker's arrays, theta as numbers)."""
+    return {"batchSize": rec.batch_size.tolist(), "alpha": rec.alpha.tolist(), "eps": rec.eps.tolist(),
+            "Jhat": rec.J_hat.tolist(), "grad": rec.grad[:, 0].tolist(), "theta": rec.theta[:, 0].tolist(),
+            "J": rec.J.tolist()}
+
+
+VACUOUS = "the improvement ratio carries no information"
+#: Hoeffding with its theoretical range at 10^4 trajectories: no update moves theta. The
+#: defaults (Bernstein, empirical range) move it from the first batch.
+FROZEN = {"bound": "hoeffding", "vanilla_n": "off"}
+
+
+def test_page_summary_and_text_match_the_kernel_twin():
+    """Fed safepg's records, the page's summary gives the same theta movement (1e-12), the
+    same vacuity flag and the same summary lines, word for word, as live_learner's."""
+    data = live_batch_size_explorer().data
+    # A stored run for the defaults' key (made up: the line's words are checked), 2.5 mean iterations.
+    data["runs"]["gpomdp-bernstein-er-delta=0.95-clipped"] = {
+        "name": "table-5.2-made-up", "seeds": 2, "iteration": [1, 2], "start": [0, 100], "batch_size": [100, 200],
+        "alpha": [1e-5, 2e-5], "J": [-50.0] * len(data["grid"]),
+        "budgets": {"10000": {"upsilon_bar": -12.05, "iterations": 2.5}}}
+    cases = [page_params(**FROZEN), page_params(), page_params(bound="chebyshev", vanilla_alpha="1e-6"),
+             page_params(bound="hoeffding", budget="100000", vanilla_n="100")]
+    recs = [python_runs(p) for p in cases]
+    got = run_node({"page": {"src": str(PAGE), "data": data, "cases": [
+        {"p": p, "runs": {k: {"rec": as_page_record(r)} for k, r in rs.items()}} for p, rs in zip(cases, recs)]}})
+    flags = []
+    for p, rs, js in zip(cases, recs, got["page"]):
+        values: dict[str, Any] = {"thesis": js["values"]["thesis"], "vanilla": None}
+        assert values["thesis"]["found"] is (p["bound"] == "bernstein-er")  # the made-up stored run
+        for name, rec in rs.items():
+            py = values[name] = run_summary(rec, still_tolerance(data))
+            v = js["values"][name]
+            assert set(v) == set(py)
+            assert close(v["theta_moved"], py["theta_moved"]), (name, v["theta_moved"], py["theta_moved"])
+            assert v["ratio_vacuous"] is py["ratio_vacuous"]
+            for k in ("iterations", "trajectories", "first_batches", "J_at", "diverged"):
+                assert v[k] == py[k], (name, k)
+            for k in ("upsilon_bar", "improvement_ratio", "J_final", "theta_final"):
+                assert close(v[k], py[k]), (name, k, v[k], py[k])
+            flags.append(py["ratio_vacuous"])
+        assert js["text"].split("<br>") == summary_text(values, data, int(p["budget"])).split("\n")
+        assert (VACUOUS in js["text"].split("<br>")[0]) is values["adaptive"]["ratio_vacuous"]
+    assert flags[0] and not flags[1] and True in flags[2:] and False in flags[2:]  # both kinds of run
+    assert "(seed mean, first 10000 trajectories): 3 iterations, Upsilon-bar -12.0500." in got["page"][1]["text"]
+
+
+def test_page_flags_a_frozen_run_of_its_own_learner():
+    """The page's own learner (its random numbers): the frozen run's line says its improvement
+    ratio carries no information; a run that moves states its ratio."""
+    data = live_batch_size_explorer().data
+    frozen, moving = page_params(**FROZEN), page_params(vanilla_n="off")
+
+    def cfg(p: dict[str, Any]) -> dict[str, Any]:
+        return {"sigma": p["sigma"], "estimator": p["estimator"], "baseline": True, "score": p["score"],
+                "budget": int(p["budget"]), "seed": 0, "theta0": 0, "bound": p["bound"].replace("-er", ""),
+                "delta": p["delta"], "empiricalRange": p["bound"].endswith("-er")}
+
+    got = run_node({"page": {"src": str(PAGE), "data": data, "cases": [
+        {"p": p, "runs": {"adaptive": {"cfg": cfg(p)}}} for p in (frozen, moving)]}, "task": task_data()})["page"]
+    f, m = (g["text"].split("<br>")[0] for g in got)
+    assert got[0]["values"]["adaptive"]["theta_moved"] == 0 and got[0]["values"]["adaptive"]["ratio_vacuous"]
+    assert f.endswith("; theta moved by 0, less than 0.1% of the way to theta* = -0.59: " + VACUOUS + "."), f
+    a = got[1]["values"]["adaptive"]
+    assert not a["ratio_vacuous"] and a["theta_moved"] > 1e-3 and VACUOUS not in m
+    assert m.endswith(f"; theta moved by {a['theta_moved']:.4f}, improvement ratio "
+                      f"{100 * a['improvement_ratio']:.2f}%."), m
 
 
 def test_normals_are_standard_normal(tmp_path):

@@ -13,7 +13,16 @@ import pytest
 
 from safepg.learning import LearningRecord
 from safepg.thesis.experiments import get_experiment, t52_name
-from safepg.thesis.explorers.live_learner import BUDGETS, learner_js, live_batch_size_explorer, task_data
+from safepg.thesis.explorers.live_learner import (
+    BUDGETS,
+    STILL,
+    learner_js,
+    live_batch_size_explorer,
+    task_data,
+    theta_moved,
+)
+
+VACUOUS = "the improvement ratio carries no information"
 
 
 def fake_record(batch_sizes: list[int], seed: int) -> LearningRecord:
@@ -130,3 +139,52 @@ def test_python_twin_reports_progress_and_stops_when_told():
 
     with pytest.raises(Stop):
         ex.compute_py({**ex.defaults(), "budget": "3000000"}, progress=stop)
+
+
+def test_theta_moved_is_the_furthest_theta_got_from_theta_0():
+    assert theta_moved(np.array([[0.0], [-0.2], [-0.5], [-0.4]])) == 0.5
+    assert theta_moved(np.array([[0.1], [0.3], [0.1]])) == pytest.approx(0.2)  # out and back: it moved
+    assert theta_moved(np.array([[0.0]])) == 0.0  # no iteration
+    assert theta_moved(np.array([[0.0, 1.0], [0.5, 0.0]])) == 1.0  # the largest component
+
+
+def test_frozen_run_says_its_ratio_carries_no_information():
+    """Hoeffding with its theoretical range: eps(N) >= |g| at N = 100, so the first update is
+    no step; at 10^4 trajectories the run stops before a second one could move theta."""
+    ex = live_batch_size_explorer()
+    res = ex.compute_py({**ex.defaults(), "bound": "hoeffding", "budget": "10000", "vanilla_n": "off"})
+    a = res["values"]["adaptive"]
+    assert a["theta_moved"] == 0.0 and a["ratio_vacuous"] and a["improvement_ratio"] == 1.0  # 100% of no-ops
+    first = res["text"].splitlines()[0]
+    assert first.startswith("Algorithm 4.1: 2 iterations, 10000 trajectories, Upsilon-bar ")
+    assert first.endswith("; theta moved by 0, less than 0.1% of the way to theta* = -0.59: " + VACUOUS + ".")
+    assert "improvement ratio 100" not in res["text"]
+
+
+def test_run_moving_too_little_is_flagged_with_its_movement():
+    """The reviewer's run (Hoeffding, theoretical range, 10^6 trajectories, seed 0): two steps of
+    alpha ~ 3.7e-6 move theta by 7e-5, 0.01% of the way to theta*; J moves by 0.07 of its 43."""
+    ex = live_batch_size_explorer()
+    res = ex.compute_py({**ex.defaults(), "bound": "hoeffding", "budget": "1000000", "vanilla_n": "off"})
+    a = res["values"]["adaptive"]
+    assert a["iterations"] == 3 and 0 < a["theta_moved"] < STILL * 0.588 and a["ratio_vacuous"]
+    assert f"theta moved by {a['theta_moved']:.1e}".replace("e-05", "e-5") in res["text"]
+    assert VACUOUS in res["text"].splitlines()[0]
+
+
+def test_moving_run_states_its_ratio_and_every_objective():
+    ex = live_batch_size_explorer()
+    res = ex.compute_py({**ex.defaults(), "budget": "10000"})  # Bernstein (e.r.): theta moves from the first batch
+    lines = res["text"].splitlines()
+    v = res["values"]
+    for name, line in (("adaptive", lines[0]), ("vanilla", lines[1])):
+        assert not v[name]["ratio_vacuous"] and v[name]["theta_moved"] > STILL * 0.588
+        assert v[name]["theta_moved"] == pytest.approx(abs(v[name]["theta_final"]))  # from theta_0 = 0, one way
+        assert VACUOUS not in line
+        assert line.endswith(f"; theta moved by {v[name]['theta_moved']:.4f}, improvement ratio "
+                             f"{100 * v[name]['improvement_ratio']:.2f}%."), line
+    assert lines[1].startswith("vanilla PG: 10 iterations, 10000 trajectories")
+    assert lines[-1] == ("Upsilon-bar: the simulated return (clipped states and actions, 20 steps, discounted by "
+                         "gamma = 0.9), averaged over all trajectories. J and the improvement ratio (share of updates "
+                         "after which J did not fall): the closed-form J(theta) of the J plot (infinite horizon, "
+                         "no clipping).")

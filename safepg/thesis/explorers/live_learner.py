@@ -19,6 +19,14 @@ distribution.
 Where the controls match one of the stored Table 5.2 runs (sigma = 1, baseline on and the
 estimator, bound, delta and score of a stored configuration) the seed mean of that run,
 computed by safepg when the book was built, is drawn beside the live curve.
+
+Each run's summary line says how far theta moved (the furthest theta got from theta_0) and,
+when that is under ``STILL`` of the way from theta_0 to theta* (the run barely moved: the
+updates it counts are no-ops or steps too small to show on J), that the improvement ratio
+carries no information: an update that leaves theta where it was counts as one after
+which J did not decrease. A last line says which objective each number is on:
+Upsilon-bar on the simulated (clipped, H-step, discounted) return, J and the improvement
+ratio on the closed-form J(theta) that the J plot draws.
 """
 
 from __future__ import annotations
@@ -26,6 +34,7 @@ from __future__ import annotations
 import hashlib
 import html
 import json
+import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -47,6 +56,11 @@ CURVE_POINTS = 600
 DIGITS = 6
 BOUND_CHOICES = (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"), ("hoeffding-er", "Hoeffding (e.r.)"),
                  ("bernstein", "Bernstein"), ("bernstein-er", "Bernstein (e.r.)"))
+#: A run whose theta stays within this share of |theta* - theta_0| of theta_0 did not move:
+#: its improvement ratio carries no information. On the 1-D LQG from theta_0 = 0 that is
+#: 5.9e-4 (theta* = -0.588), over which J rises by 0.54 of the 43.5 from J(0) to J(theta*):
+#: a J curve flat at the plot's scale.
+STILL = 1e-3
 #: ``progress`` of the Python twin: ``report(fraction, message)`` (see ``Explorer.compute_reports_progress``).
 Reporter = Callable[[float, str], object]
 TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in your browser"
@@ -190,7 +204,8 @@ def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | N
         run = _stored_run(c, recs, grid)
         runs[overlay_key(run)] = run
     style = plotting.style_table()
-    data = {"task": task, "grid": grid.tolist(), "runs": runs, "points": CURVE_POINTS,
+    data = {"task": task, "grid": grid.tolist(), "runs": runs, "points": CURVE_POINTS, "still": STILL,
+            "theta_star": float(np.asarray(env.optimal_gain(), dtype=float).reshape(-1)[0]),
             "muted": plotting.MUTED, "vanilla_color": "#444444",
             "colors": {k: v["color"] for k, v in style["bounds"].items()}}
 
@@ -217,12 +232,85 @@ def live_batch_size_explorer(records: Mapping[str, Sequence[LearningRecord]] | N
     return LiveLearnerExplorer(TITLE, controls, plots, "", compute_py, data)
 
 
-def _summary(rec: LearningRecord) -> dict[str, Any]:
+def theta_moved(theta: Any) -> float:
+    """How far theta moved over a run: the largest |theta_i - theta_0| over its iterations
+    and components (|theta_final - theta_0| for a run that moves one way)."""
+    t = np.asarray(theta, dtype=float)
+    t = t.reshape(t.shape[0], -1)
+    return float(np.max(np.abs(t - t[0])))
+
+
+def still_tolerance(data: Mapping[str, Any], theta0: float = 0.0) -> float:
+    """The movement under which a run counts as still: ``STILL`` of |theta* - theta_0|."""
+    return float(data["still"]) * abs(float(data["theta_star"]) - theta0)
+
+
+def run_summary(rec: LearningRecord, tol: float) -> dict[str, Any]:
+    """The page's summary of one run (``safepgLiveSummary``): safepg's, plus ``theta_moved``
+    (:func:`theta_moved`) and ``ratio_vacuous`` (no iteration, or theta moved less than ``tol``)."""
     s = rec.summary()
+    moved = theta_moved(rec.theta)
     return {"iterations": s["iterations"], "trajectories": s["trajectories"], "upsilon_bar": s["upsilon_bar"],
             "improvement_ratio": s["improvement_ratio"], "J_final": s["J_final"], "theta_final": s["theta"][0],
+            "theta_moved": moved, "ratio_vacuous": bool(s["iterations"] == 0 or moved < tol),
             "J_at": {k: v for k, v in s["J_at"].items() if int(k) <= BUDGETS[-1]},
             "first_batches": rec.batch_size[:3].tolist(), "done": True, "diverged": rec.diverged}
+
+
+def _fixed(v: Any, digits: int) -> str:
+    """The page's number format: ``digits`` decimals, "-" for none."""
+    return "-" if v is None or not np.isfinite(v) else f"{v:.{digits}f}"
+
+
+def _moved_text(v: float) -> str:
+    """A movement as the page writes it: 0, 7.0e-5 under 10^-3, else 4 decimals."""
+    if not np.isfinite(v):
+        return "-"
+    if v == 0:
+        return "0"
+    if v < 1e-3:
+        mantissa, exponent = f"{v:.1e}".split("e")
+        return f"{mantissa}e{int(exponent):+d}"  # JavaScript's toExponential(1): 7.0e-5
+    return f"{v:.4f}"
+
+
+def run_line(name: str, v: Mapping[str, Any], data: Mapping[str, Any]) -> str:
+    """One run's summary line (the page's ``safepgLiveLine``, word for word)."""
+    moved = _moved_text(v["theta_moved"])
+    if v["ratio_vacuous"]:
+        ratio = (f"theta moved by {moved}, less than {100 * data['still']:g}% of the way to theta* = "
+                 f"{_fixed(data['theta_star'], 2)}: the improvement ratio carries no information")
+    else:
+        ratio = f"theta moved by {moved}, improvement ratio {_fixed(100 * v['improvement_ratio'], 2)}%"
+    return (f"{name}: {v['iterations']} iterations, {v['trajectories']} trajectories, "
+            f"Upsilon-bar {_fixed(v['upsilon_bar'], 4)}, J {_fixed(v['J_final'], 3)} at theta "
+            f"{_fixed(v['theta_final'], 4)}{' (diverged)' if v['diverged'] else ''}; {ratio}.")
+
+
+def objectives_line(data: Mapping[str, Any]) -> str:
+    """Which objective each number is on (the page's ``safepgLiveObjectives``)."""
+    t = data["task"]
+    return (f"Upsilon-bar: the simulated return (clipped states and actions, {t['H']} steps, discounted by "
+            f"gamma = {t['gamma']:g}), averaged over all trajectories. J and the improvement ratio (share of "
+            "updates after which J did not fall): the closed-form J(theta) of the J plot (infinite horizon, "
+            "no clipping).")
+
+
+def summary_text(values: Mapping[str, Any], data: Mapping[str, Any], budget: int) -> str:
+    """The text under the plots, one line per run, the stored run, the objectives (the page's
+    ``safepgLiveText``; the page joins the lines with <br>, this with newlines)."""
+    lines = [run_line("Algorithm 4.1", values["adaptive"], data)]
+    if values.get("vanilla"):
+        lines.append(run_line("vanilla PG", values["vanilla"], data))
+    th = values["thesis"]
+    if th["found"]:  # toFixed(0) rounds halves up
+        lines.append(f"stored safepg run {th['name']} (seed mean, first {budget} trajectories): "
+                     f"{math.floor(th['iterations'] + 0.5)} iterations, Upsilon-bar {_fixed(th['upsilon_bar'], 4)}.")
+    else:
+        lines.append("no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, "
+                     "delta in {0.05, 0.25, 0.5, 0.75, 0.95}).")
+    lines.append(objectives_line(data))
+    return "\n".join(lines)
 
 
 def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
@@ -282,11 +370,9 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         T = np.unique(np.maximum(1, np.round(1 + np.arange(data["points"]) * (budget - 1) / (data["points"] - 1))))
         T = T[T <= rec.trajectories].astype(np.int64)
         plots["J"]["series"].append({"x": T.tolist(), "y": performance_on_grid([rec], T)[0].tolist(), **style})
-        values[name] = _summary(rec)
-    a = values["adaptive"]
-    text = (f"Algorithm 4.1: {a['iterations']} iterations, Upsilon-bar {a['upsilon_bar']:.4f}, "
-            f"improvement ratio {100 * a['improvement_ratio']:.2f}%")
-    return {"plots": plots, "values": values, "text": text}
+        values[name] = run_summary(rec, still_tolerance(data, float(rec.theta[0, 0])))
+    return {"plots": plots, "values": values, "text": summary_text(values, data, budget)}
 
 
-__all__ = ["BUDGETS", "LiveLearnerExplorer", "learner_js", "live_batch_size_explorer", "task_data"]
+__all__ = ["BUDGETS", "STILL", "LiveLearnerExplorer", "learner_js", "live_batch_size_explorer", "objectives_line",
+           "run_line", "run_summary", "still_tolerance", "summary_text", "task_data", "theta_moved"]

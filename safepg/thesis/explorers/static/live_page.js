@@ -22,13 +22,19 @@ function safepgLiveThin(n, points) {
   }
   return o;
 }
-function safepgLiveSummary(r) {
-  // safepg.learning.LearningRecord's summary of a (possibly partial) record.
+function safepgLiveSummary(r, tol) {
+  // safepg.learning.LearningRecord's summary of a (possibly partial) record, with how far
+  // theta moved (live_learner.theta_moved) and whether that is under tol (the ratio is vacuous).
   const I = r.batchSize.length;
-  let tot = 0, w = 0, up = 0;
+  let tot = 0, w = 0, up = 0, moved = 0;
   for (let i = 0; i < I; i++) {
     tot += r.batchSize[i]; w += r.batchSize[i] * r.Jhat[i];
     if (r.J[i + 1] - r.J[i] >= 0) up++;
+  }
+  for (let i = 1; i <= I; i++) {
+    const d = Math.abs(r.theta[i] - r.theta[0]);
+    if (Number.isNaN(d)) { moved = NaN; break; }  // NaN, as numpy's max
+    if (d > moved) moved = d;
   }
   const Jat = {};
   let end = 0, i = 0;
@@ -38,8 +44,42 @@ function safepgLiveSummary(r) {
     Jat[String(T)] = r.J[i];
   }
   return {iterations: I, trajectories: tot, upsilon_bar: I ? w / tot : null, improvement_ratio: I ? up / I : null,
-          J_final: r.J[I], theta_final: r.theta[I], J_at: Jat, first_batches: r.batchSize.slice(0, 3),
-          done: r.done, diverged: r.diverged};
+          J_final: r.J[I], theta_final: r.theta[I], theta_moved: moved, ratio_vacuous: I === 0 || moved < tol,
+          J_at: Jat, first_batches: r.batchSize.slice(0, 3), done: r.done, diverged: r.diverged};
+}
+function safepgLiveFixed(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d); }
+function safepgLiveLine(name, v, data) {
+  // One run's summary line: live_learner.run_line, word for word.
+  const m = v.theta_moved;
+  const moved = !isFinite(m) ? "-" : m === 0 ? "0" : m < 1e-3 ? m.toExponential(1) : m.toFixed(4);
+  const ratio = v.ratio_vacuous
+    ? `theta moved by ${moved}, less than ${100 * data.still}% of the way to theta* = ` +
+      `${safepgLiveFixed(data.theta_star, 2)}: the improvement ratio carries no information`
+    : `theta moved by ${moved}, improvement ratio ${safepgLiveFixed(100 * v.improvement_ratio, 2)}%`;
+  return `${name}: ${v.iterations} iterations, ${v.trajectories} trajectories, ` +
+    `Upsilon-bar ${safepgLiveFixed(v.upsilon_bar, 4)}, J ${safepgLiveFixed(v.J_final, 3)} at theta ` +
+    `${safepgLiveFixed(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}; ${ratio}.`;
+}
+function safepgLiveObjectives(data) {
+  // Which objective each number is on: live_learner.objectives_line.
+  const t = data.task;
+  return `Upsilon-bar: the simulated return (clipped states and actions, ${t.H} steps, discounted by ` +
+    `gamma = ${t.gamma}), averaged over all trajectories. J and the improvement ratio (share of ` +
+    "updates after which J did not fall): the closed-form J(theta) of the J plot (infinite horizon, " +
+    "no clipping).";
+}
+function safepgLiveText(values, data, B) {
+  // The lines under the plots: live_learner.summary_text (joined here with <br>).
+  const lines = [];
+  if (values.adaptive) lines.push(safepgLiveLine("Algorithm 4.1", values.adaptive, data));
+  if (values.vanilla) lines.push(safepgLiveLine("vanilla PG", values.vanilla, data));
+  lines.push(values.thesis.found
+    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ` +
+      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${safepgLiveFixed(values.thesis.upsilon_bar, 4)}.`
+    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, " +
+      "delta in {0.05, 0.25, 0.5, 0.75, 0.95}).");
+  lines.push(safepgLiveObjectives(data));
+  return lines.join("<br>");
 }
 function safepgLiveResult(p, st, data) {
   // The same structure as compute_py: plots (series), values, text.
@@ -84,20 +124,10 @@ function safepgLiveResult(p, st, data) {
       gx.push(T); gy.push(r.J[Math.min(i, I)]);
     }
     plots.J.series.push({label: label, x: gx, y: gy, ...style});
-    values[name] = safepgLiveSummary(r);
+    values[name] = safepgLiveSummary(r, data.still * Math.abs(data.theta_star - r.theta[0]));
     values.run_ms[name] = r.ms;
   }
-  const f = (v, d) => (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d);
-  const line = (name, v) => v ? `${name}: ${v.iterations} iterations, ${v.trajectories} trajectories, ` +
-    `Upsilon-bar ${f(v.upsilon_bar, 4)}, improvement ratio ${f(100 * v.improvement_ratio, 2)}%, ` +
-    `J ${f(v.J_final, 3)} at theta ${f(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}` : "";
-  let text = line("Algorithm 4.1", values.adaptive);
-  if (values.vanilla) text += "<br>" + line("vanilla PG", values.vanilla);
-  text += "<br>" + (values.thesis.found
-    ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ` +
-      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${f(values.thesis.upsilon_bar, 4)}`
-    : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, " +
-      "delta in {0.05, 0.25, 0.5, 0.75, 0.95})");
+  const text = safepgLiveText(values, data, B);
   return {plots: plots, values: values, text: text};
 }
 function safepgLiveLearner(root, spec, learnerSrc) {
