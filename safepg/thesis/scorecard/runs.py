@@ -17,6 +17,7 @@ from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
 from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.judged import ci_judged, frozen, one_run_ratio, pi_text, prediction, ratio_pct
 from safepg.thesis.scorecard.rules import (
     FROZEN_THETA,
     PRINTED,
@@ -52,47 +53,6 @@ def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[fl
     if seeds < exp.seeds:  # a partly computed campaign is shown, not judged
         return {**cells, "authors": f"{text} ({seeds} of {exp.seeds} seeds: not judged)"}
     return {**cells, "authors": text, "authors_ok": check(mean, ci), **judged}
-
-
-def _pi(d: Mapping[str, Any] | None, ratio: bool = False) -> list[float] | None:
-    """The 95% prediction interval for one run of a report's entry (None without two seeds); a
-    ratio's is cut to [0, 1], where every ratio lies (which changes no verdict on a printed ratio)."""
-    pi = (d or {}).get("pi95")
-    if not pi or pi[0] is None:
-        return None
-    return [max(pi[0], 0.0), min(pi[1], 1.0)] if ratio else [float(pi[0]), float(pi[1])]
-
-
-def _pi_text(pi: Sequence[float] | None, fmt: Callable[[float], str], seeds: int | None, then: str = "") -> str:
-    """A prediction interval as the page shows it, with what it is (and ``then``, after a semicolon)."""
-    if not pi:
-        return ""
-    return f"[{fmt(pi[0])}; {fmt(pi[1])}]: 95% prediction interval for one run, {seeds} seeds" + \
-        (f"; {then}" if then else "")
-
-
-def _ci_judged(ci: Sequence[float] | None, fmt: Callable[[float], str], seeds: int | None) -> str:
-    if not ci or ci[0] is None:
-        return ""
-    return f"[{fmt(ci[0])}; {fmt(ci[1])}]: 95% interval of our mean, {seeds} seeds"
-
-
-def _frozen(moved: float | None) -> str:
-    """Why a run's improvement ratio carries no information ("" when theta moved)."""
-    if moved is None or moved >= FROZEN_THETA:
-        return ""
-    return (f"θ moved by at most {moved:.1e} over the run (below {FROZEN_THETA:g}): consecutive batch means differ "
-            "by noise alone, so the ratio carries no information.")
-
-
-def _ratio_pct(d: Mapping[str, Any] | None) -> list[float] | None:
-    pi = _pi(d, ratio=True)
-    return None if pi is None else [100 * pi[0], 100 * pi[1]]
-
-
-def _one_run_ratio(printed: float, d: Mapping[str, Any] | None) -> bool | None:
-    """Rule ``"prediction"`` on an improvement ratio: the printed percentage in our prediction interval."""
-    return in_prediction(f"{100 * printed:.6g}", _ratio_pct(d))
 
 
 def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
@@ -133,17 +93,17 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
             continue
         key = (c.sigma, c.batch_size, c.alpha)
         mean, ci = _mean_ci(r["improvement_ratio"])
-        ok = None if mean is None else _one_run_ratio(thesis, r["improvement_ratio"])
+        ok = None if mean is None else one_run_ratio(thesis, r["improvement_ratio"])
         ar = theirs.get(key)
         a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
         a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                           pct(a_mean) + ci_text(_pi(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
-                           lambda *_, t=thesis, d=ar: _one_run_ratio(t, d["improvement_ratio"]),
-                           authors_interval=_ratio_pct(ar and ar["improvement_ratio"]),
-                           authors_interval_text=_pi_text(_ratio_pct(ar and ar["improvement_ratio"]),
+                           pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
+                           lambda *_, t=thesis, d=ar: one_run_ratio(t, d["improvement_ratio"]),
+                           authors_interval=ratio_pct(ar and ar["improvement_ratio"]),
+                           authors_interval_text=pi_text(ratio_pct(ar and ar["improvement_ratio"]),
                                                           lambda x: f"{x:.1f}%", ar and ar["seeds"]),
-                           authors_vacuous=_frozen(ar and ar.get("theta_moved")))
-        pi = _ratio_pct(r["improvement_ratio"])
+                           authors_vacuous=frozen(ar and ar.get("theta_moved")))
+        pi = ratio_pct(r["improvement_ratio"])
         rc = recon.get(key)
         rc_mean = None if rc is None else rc["improvement_ratio"]["mean"]
         recon_text = "" if rc_mean is None else \
@@ -153,11 +113,12 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
         printed_text = f"{100 * thesis:.6g}"
         b.add(id=f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}", group="Section 5.1",
               quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, α = {c.alpha:.0e}", where="Table 5.1",
-              thesis=pct(thesis), ours=pct(mean) + ci_text(_pi(r["improvement_ratio"], True), lambda x: pct(x, 1)),
+              thesis=pct(thesis),
+              ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
               difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
               rule="prediction", kind="one run", page="lqg1d", heading="Table 5.1", thesis_value=thesis,
               ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds, interval=pi,
-              interval_text=_pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=_frozen(r.get("theta_moved")),
+              interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=frozen(r.get("theta_moved")),
               authors_note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} the printed value is outside our "
                            f"prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} (where all "
                            "24 of their output files start), counted as they counted (strict increases over 10^6/N - 1 "
@@ -188,7 +149,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             continue
         key = (c.estimator, c.bound, c.empirical_range, c.delta)
         mean, ci = _mean_ci(r["upsilon_bar"])
-        if _frozen(r.get("theta_moved")):  # its ratio, whatever it is, says nothing
+        if frozen(r.get("theta_moved")):  # its ratio, whatever it is, says nothing
             frozen.append(c.name)
         else:
             ratios.append(r["improvement_ratio"]["mean"])
@@ -205,11 +166,11 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                                    f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
                                    lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
                                    authors_interval=a_ci,
-                                   authors_interval_text=_ci_judged(a_ci, fmt, ar and ar["seeds"]))
+                                   authors_interval_text=ci_judged(a_ci, fmt, ar and ar["seeds"]))
             else:
                 a_cells = _authors(exp, seeds, mean, ci, guarded,
                                    lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                   authors_interval=ci, authors_interval_text=_ci_judged(ci, fmt, seeds))
+                                   authors_interval=ci, authors_interval_text=ci_judged(ci, fmt, seeds))
             mean, ci = _mean_ci(vr["upsilon_bar"])
             seeds = vr["seeds"]
             b.values["range_rows"] = (f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
@@ -226,7 +187,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
               difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
               kind="mean of runs", page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"],
               ours_value=mean, ours_ci95=ci, seeds=seeds, expected_seeds=exp.seeds, interval=ci,
-              interval_text=_ci_judged(ci, fmt, seeds),
+              interval_text=ci_judged(ci, fmt, seeds),
               authors_note=("Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the "
                             "authors' settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) "
                             "= 1280 (lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
@@ -298,18 +259,18 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         label = {"scalar": "scalar step of [24]", "coordinate": "coordinate step Λ*"}.get(c.name, c.name)
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
-            pi = _ratio_pct(r["improvement_ratio"])
+            pi = ratio_pct(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
             b.add(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", **out.cells(),
                   quantity=f"improvement ratio, {label}, N = {c.batch_size}", where="Section 5.2.1 (Figure 5.5)",
                   thesis=pct(th["improvement_ratio"]),
-                  ours=pct(mean) + ci_text(_pi(r["improvement_ratio"], True), lambda x: pct(x, 1)),
+                  ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
-                  ok=None if mean is None else _one_run_ratio(th["improvement_ratio"], r["improvement_ratio"]),
+                  ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r["improvement_ratio"]),
                   rule="prediction", kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6",
                   thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-                  expected_seeds=exp.seeds, interval=pi, interval_text=_pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]),
-                  vacuous=_frozen(r.get("theta_moved")))
+                  expected_seeds=exp.seeds, interval=pi, interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]),
+                  vacuous=frozen(r.get("theta_moved")))
         if "theta_final" in th:
             printed = np.asarray(th["theta_final"], dtype=float)
             finals = np.array([rec.theta_final.reshape(printed.shape) for rec in recs.get(c.name, [])])
@@ -333,7 +294,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                       ok=None if mean is None else in_prediction(text, pi, list(seeds)), rule="prediction",
                       kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6", thesis_value=float(p),
                       ours_value=mean, seeds=int(seeds.size), expected_seeds=exp.seeds, interval=pi,
-                      interval_text="every seed exactly 0" if p == 0 else _pi_text(pi, lambda v: f"{v:.6g}",
+                      interval_text="every seed exactly 0" if p == 0 else pi_text(pi, lambda v: f"{v:.6g}",
                                                                                    int(seeds.size)),
                       fields={"step": c.name, "entry": f"{i + 1}{j + 1}"})
 
@@ -356,11 +317,11 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
         if "upsilon_bar" in th:
             text = fmt(th["upsilon_bar"])
             mean, ci = _mean_ci(r["upsilon_bar"])
-            pi, a_pi = _pi(r["upsilon_bar"]), _pi(ar and ar["upsilon_bar"])
+            pi, a_pi = prediction(r["upsilon_bar"]), prediction(ar and ar["upsilon_bar"])
             a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
             a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
                                lambda *_, t=text, i=a_pi: in_prediction(t, i), authors_interval=a_pi,
-                               authors_interval_text=_pi_text(a_pi, fmt, ar and ar["seeds"]))
+                               authors_interval_text=pi_text(a_pi, fmt, ar and ar["seeds"]))
             out = output(c.name, "upsilon_bar") if output else None
             b.add(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(pi, fmt)}",
@@ -368,30 +329,31 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
                   page=page, heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
-                  interval=pi, interval_text=_pi_text(pi, fmt, r["seeds"]),
+                  interval=pi, interval_text=pi_text(pi, fmt, r["seeds"]),
                   authors_note=authors_note, slip_note="" if out is None else _slip(out, text, fmt),
                   remark=_missing(out) or _also(also, other, "upsilon_bar", fmt, text),
                   **a_cells, **(out.cells() if out else {}))
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             thesis = th["improvement_ratio"]
-            pi, a_pi = _ratio_pct(r["improvement_ratio"]), _ratio_pct(ar and ar["improvement_ratio"])
+            pi, a_pi = ratio_pct(r["improvement_ratio"]), ratio_pct(ar and ar["improvement_ratio"])
             a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
             a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                               pct(a_mean) + ci_text(_pi(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
-                               lambda *_, t=thesis, d=ar: _one_run_ratio(t, d["improvement_ratio"]),
+                               pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True),
+                                                     lambda x: pct(x, 1)),
+                               lambda *_, t=thesis, d=ar: one_run_ratio(t, d["improvement_ratio"]),
                                authors_interval=a_pi,
-                               authors_interval_text=_pi_text(a_pi, lambda x: f"{x:.1f}%", ar and ar["seeds"]),
-                               authors_vacuous=_frozen(ar and ar.get("theta_moved")))
+                               authors_interval_text=pi_text(a_pi, lambda x: f"{x:.1f}%", ar and ar["seeds"]),
+                               authors_vacuous=frozen(ar and ar.get("theta_moved")))
             out = output(c.name, "improvement_ratio") if output else None
             b.add(id=f"{table}/{c.name}/improvement-ratio", group=group, quantity=f"improvement ratio, {method}",
                   where=table.replace("table-", "Table "), thesis=pct(thesis),
-                  ours=pct(mean) + ci_text(_pi(r["improvement_ratio"], True), lambda x: pct(x, 1)),
+                  ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
-                  ok=None if mean is None else _one_run_ratio(thesis, r["improvement_ratio"]), rule="prediction",
+                  ok=None if mean is None else one_run_ratio(thesis, r["improvement_ratio"]), rule="prediction",
                   kind="one run", page=page, heading=heading, thesis_value=thesis, ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, interval=pi,
-                  interval_text=_pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=_frozen(r.get("theta_moved")),
+                  interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=frozen(r.get("theta_moved")),
                   fields={"method": c.name, "quantity": "improvement_ratio"}, authors_note=authors_note,
                   slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
                   remark=_missing(out) or _also(also, other, "improvement_ratio", pct, f"{100 * thesis:.6g}", 100),
@@ -410,7 +372,7 @@ def _also(also: tuple[Experiment, Mapping[str, Any]] | None, row: Mapping[str, A
             f"from their own baseline policy, theta_star.npy@a82576f ({exp.name}, one start for all seeds)")
     if row is None or not row["seeds"] or row[key]["mean"] is None:
         return f"{what}: not stored yet."
-    m, pi = row[key]["mean"], _pi(row[key], ratio=key == "improvement_ratio")
+    m, pi = row[key]["mean"], prediction(row[key], ratio=key == "improvement_ratio")
     if pi is None:
         return f"{what}: {fmt(m)} ({row['seeds']} of {exp.seeds} seeds)."
     holds = in_prediction(printed, [scale * pi[0], scale * pi[1]])
@@ -463,14 +425,14 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
         a_cells = _authors(authors, len(a_vals), a_mean, None,
                            "-" if a_mean is None else f"{a_mean:.0f} (seeds {min(a_vals):.0f} to {max(a_vals):.0f})",
                            lambda *_, i=a_pi, t=printed: in_prediction(t, i), authors_interval=a_pi,
-                           authors_interval_text=_pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading))
+                           authors_interval_text=pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading))
         b.values[f"authors_settings_{key}"] = _said(a_cells)
         b.add(id=rid, group="Section 5.2", quantity=q, where="Section 5.2.1 (Figure 5.7)", thesis=f"≈ {printed}",
               ours="-" if mean is None else f"{mean:.0f} (seeds {min(vals):.0f} to {max(vals):.0f})",
               difference="-" if mean is None else f"{mean - float(printed):+.0f}",
               ok=None if mean is None else in_prediction(printed, pi), rule="reading", kind="read off a figure",
               page="lqg2d", heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
-              interval=pi, interval_text=_pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
+              interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
               expected_seeds=seeds, authors_note=note, slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"),
               **a_cells, **out.cells())
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
@@ -505,7 +467,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
         a_cells = _authors(a_base, len(a_its), a_mean, None,
                            "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
                            lambda *_, i=a_pi, t=text: in_prediction(t, i), authors_interval=a_pi,
-                           authors_interval_text=_pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
+                           authors_interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
         b.values["authors_baseline"] = _said(a_cells)
         b.add(id="section-5.3/baseline-iterations", group="Section 5.3",
               quantity=f"iterations of the baseline (N = {c.batch_size}, α = {c.alpha:g}) to reach "
@@ -514,7 +476,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
               difference="-" if mean is None else f"{mean - th['iterations']:+.1f}",
               ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
               page="cartpole", heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean,
-              seeds=len(its), interval=pi, interval_text=_pi_text(pi, lambda v: f"{v:.1f}", len(its)),
+              seeds=len(its), interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.1f}", len(its)),
               expected_seeds=base_exp.seeds, **a_cells, **outputs.cartpole("baseline", "iterations").cells(),
               authors_note="Reproduced on the authors' task: gym's 12° termination (cartpole/cartpole.py@b9588b7:42; "
                            "the thesis prints 41.8°), the undiscounted return (cartpole/polgrad.py@aadbf5b:178), and "
@@ -548,7 +510,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
           ("none" if not set(updated) & set(never) else "also updates " + b.values["extra"]),
           ok=None if updated is None else not set(updated) & set(never), rule="set", kind="one run",
           page="cartpole", heading="Table 5.4",
-          vacuous=_frozen((_report_row(rep54, "adaptive") or {}).get("theta_moved")),
+          vacuous=frozen((_report_row(rep54, "adaptive") or {}).get("theta_moved")),
           **{**a_cells, "authors_value": None},
           authors_output=", ".join(_STATE[i] for i in range(4) if i not in theirs),
           authors_output_source=outputs.cartpole("adaptive", "upsilon_bar").source,
