@@ -128,3 +128,27 @@ def test_kind_and_judged_interval_reach_the_files_and_the_page(tmp_path):
     page = sc.group_html(b.rows, "Section 5.3") + sc.summary_html(b.rows)
     assert 'data-kind="one run"' in page and "95% prediction interval for one run, 5 seeds" in page
     assert 'class="sc-status sc-vacuous"' in page
+
+
+def test_a_ratio_is_judged_within_one_update_of_our_seeds():
+    from safepg.thesis.scorecard.judged import one_run_ratio, ratio_interval
+
+    # Five seeds at 100% over 100 iterations: a printed 98.99% (98 of 99 updates) is one update away.
+    row = {"improvement_ratio": seed_summary95([1.0] * 5), "iterations": 100.0, "seeds": 5}
+    assert ratio_interval(row) == pytest.approx([100 - 100 / 99, 100.0])
+    assert one_run_ratio(0.9899, row) and not one_run_ratio(0.9797, row)  # two updates away
+    assert one_run_ratio(0.5, {"improvement_ratio": seed_summary95([0.5]), "iterations": 9.0, "seeds": 1}) is None
+
+
+def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status(tmp_path):
+    b = Builder()
+    b.add(id="f/authors", ok=True, vacuous=FROZEN, authors_ok=True, authors="53.06%", authors_note="Their run.",
+          **COMMON)
+    b.add(id="f/clean", ok=True, **COMMON)
+    flagged, clean = b.rows
+    assert flagged.status == sc.AUTHORS_STATUS and flagged.no_information == FROZEN
+    assert "agrees too, without information" in flagged.explanation and not clean.no_information
+    page = sc.group_html(b.rows, "Section 5.3")
+    assert page.count("no information</span>") == 1
+    summary = sc.summary_html(b.rows)
+    assert "of which one of ours agrees without information" in summary

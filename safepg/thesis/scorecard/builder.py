@@ -83,8 +83,12 @@ class Builder:
             status = "differs (explained)"
         else:
             status = "open"
+        # An agreement without information, on a column the status did not come from, is still said.
+        no_information = (vacuous if ok else "") or (authors_vacuous if authors_ok else "")
         if status in (AUTHORS_STATUS, AUTHORS_ERROR_STATUS):
             explanation = authors_note or explanation or ""
+            if ok and vacuous:
+                explanation += f" Ours (the thesis's text) agrees too, without information: {vacuous}"
         elif status == VACUOUS_STATUS:
             explanation = " ".join(t for t in (vacuous if judged_on == "ours" else authors_vacuous, explanation) if t)
         elif explanation is None:
@@ -112,4 +116,5 @@ class Builder:
                              link=link, judged_on=judged_on, slip=bool(slip_note), kind=kind,
                              judged_interval=authors_interval if on_authors else interval,
                              judged_interval_text=authors_interval_text if on_authors else interval_text,
-                             judged_seeds=extra.get("authors_seeds" if on_authors else "seeds"), **extra))
+                             judged_seeds=extra.get("authors_seeds" if on_authors else "seeds"),
+                             no_information=no_information, **extra))

@@ -49,13 +49,14 @@ def summary_html(rows: Sequence[Row], css: bool = True) -> str:
     ``css``: include the style sheet of the scorecard tables (once per page is enough).
     """
     c = counts(rows)
+    flagged = {g: sum(bool(r.no_information) for r in rows if g in ("all", r.group)) for g in c}
     head = "<tr><th>part of the thesis</th>" + "".join(f"<th>{_status_html(s)}</th>" for s in STATUSES) + \
-        "<th>rows</th></tr>"
+        "<th>rows</th><th>of which one of ours agrees without information</th></tr>"
     body = []
     for g, n in c.items():
         name = "<strong>all</strong>" if g == "all" else f'<a href="#{heading_id(g)}">{html.escape(g)}</a>'
         body.append(f"<tr><td>{name}</td>" + "".join(f'<td class="sc-num">{n[s]}</td>' for s in STATUSES)
-                    + f'<td class="sc-num">{sum(n.values())}</td></tr>')
+                    + f'<td class="sc-num">{sum(n.values())}</td><td class="sc-num">{flagged[g]}</td></tr>')
     table = f'<table class="sc-table sc-summary"><thead>{head}</thead><tbody>{"".join(body)}</tbody></table>'
     return _wrap(table, css, "rows per status")
 
@@ -130,6 +131,8 @@ def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
         ours = _cell(r.ours, r.ours_tex)
         if r.judged_on == "ours" and r.status in ("reproduced", AUTHORS_STATUS) and not r.ours_tex:
             ours = ours.replace('<td class="', '<td class="sc-judged ', 1)
+        if r.no_information:  # flagged where it stands, whatever the status
+            ours = ours.replace("</td>", '<span class="sc-slip sc-noinfo">no information</span></td>', 1)
         body.append(
             f'<tr class="sc-row" data-id="{html.escape(r.id)}" data-status="{html.escape(r.status)}" '
             f'data-kind="{html.escape(r.kind)}" data-judged-on="{html.escape(r.judged_on)}" '

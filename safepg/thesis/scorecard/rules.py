@@ -109,7 +109,10 @@ RULES: dict[str, str] = {
                   "5 seeds overlaps the printed one (two estimates of the same mean).",
     "prediction": "A number from one run: reproduced when the printed value lies in our 95% prediction interval "
                   "for one run, mean ± t(0.975, k-1)·s·√(1 + 1/k) over our k seeds, widened by half a unit of its "
-                  "last printed digit (a printed 0 must be exactly 0 in every seed).",
+                  "last printed digit (a printed 0 must be exactly 0 in every seed). An improvement ratio takes "
+                  "the values k/n of its run's n updates: its interval is also widened by one update's share, so that "
+                  "seeds that all agree (100% on a run that improves at each update) do not reject a run that differs "
+                  "from them by one update.",
     "reading": "A number read off a figure of one run (\"≈ 500\"): reproduced when the printed value, give or take "
                "the reading precision the row states (half a unit of its last significant digit), meets our 95% "
                "prediction interval for one run.",
@@ -270,6 +273,9 @@ class Row:
         5 seeds").
     judged_seeds : int or None
         The seeds behind the judged column.
+    no_information : str
+        Why one of our columns agrees with the print without information ("" when none does): the
+        row is flagged, and counted at the top of the page, whatever its status.
     """
 
     id: str
@@ -304,6 +310,7 @@ class Row:
     judged_interval: list[float] | None = None
     judged_interval_text: str = ""
     judged_seeds: int | None = None
+    no_information: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

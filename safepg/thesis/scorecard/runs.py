@@ -17,7 +17,15 @@ from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
 from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import Builder
-from safepg.thesis.scorecard.judged import ci_judged, frozen, one_run_ratio, pi_text, prediction, ratio_pct
+from safepg.thesis.scorecard.judged import (
+    ci_judged,
+    frozen,
+    one_run_ratio,
+    pi_text,
+    prediction,
+    ratio_interval,
+    ratio_text,
+)
 from safepg.thesis.scorecard.rules import (
     FROZEN_THETA,
     PRINTED,
@@ -93,17 +101,14 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
             continue
         key = (c.sigma, c.batch_size, c.alpha)
         mean, ci = _mean_ci(r["improvement_ratio"])
-        ok = None if mean is None else one_run_ratio(thesis, r["improvement_ratio"])
+        ok = None if mean is None else one_run_ratio(thesis, r)
         ar = theirs.get(key)
         a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
         a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
                            pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
-                           lambda *_, t=thesis, d=ar: one_run_ratio(t, d["improvement_ratio"]),
-                           authors_interval=ratio_pct(ar and ar["improvement_ratio"]),
-                           authors_interval_text=pi_text(ratio_pct(ar and ar["improvement_ratio"]),
-                                                          lambda x: f"{x:.1f}%", ar and ar["seeds"]),
+                           lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
+                           authors_interval=ratio_interval(ar), authors_interval_text=ratio_text(ar),
                            authors_vacuous=frozen(ar and ar.get("theta_moved")))
-        pi = ratio_pct(r["improvement_ratio"])
         rc = recon.get(key)
         rc_mean = None if rc is None else rc["improvement_ratio"]["mean"]
         recon_text = "" if rc_mean is None else \
@@ -117,8 +122,8 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
               ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
               difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
               rule="prediction", kind="one run", page="lqg1d", heading="Table 5.1", thesis_value=thesis,
-              ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds, interval=pi,
-              interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=frozen(r.get("theta_moved")),
+              ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds,
+              interval=ratio_interval(r), interval_text=ratio_text(r), vacuous=frozen(r.get("theta_moved")),
               authors_note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} the printed value is outside our "
                            f"prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} (where all "
                            "24 of their output files start), counted as they counted (strict increases over 10^6/N - 1 "
@@ -142,7 +147,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
         if vc.theoretical_range is None:
             lemma[(vc.estimator, vc.bound, vc.empirical_range, vc.delta)] = (vc, vr)
-    ratios, frozen = [], []
+    ratios, still = [], []
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
         if "upsilon_bar" not in th:
@@ -150,7 +155,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         key = (c.estimator, c.bound, c.empirical_range, c.delta)
         mean, ci = _mean_ci(r["upsilon_bar"])
         if frozen(r.get("theta_moved")):  # its ratio, whatever it is, says nothing
-            frozen.append(c.name)
+            still.append(c.name)
         else:
             ratios.append(r["improvement_ratio"]["mean"])
         out = outputs.table_5_2(key)
@@ -207,7 +212,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
           difference="-" if low is None else f"{100 * (low - 1):+.2f} points",
           ok=None if low is None or len(got) < len(ratios) else within_points(low, 1.0), rule="ratio-points",
           kind="statement", page="lqg1d", heading="Table 5.2", thesis_value=1.0, ours_value=low,
-          remark=f"Left out, θ frozen (moving by less than {FROZEN_THETA:g}): {', '.join(frozen)}." if frozen else "")
+          remark=f"Left out, θ frozen (moving by less than {FROZEN_THETA:g}): {', '.join(still)}." if still else "")
 
 
 def _median_steps(recs: Mapping[str, Sequence], names: list[str], seeds: int) -> list[float] | None:
@@ -259,17 +264,16 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         label = {"scalar": "scalar step of [24]", "coordinate": "coordinate step Λ*"}.get(c.name, c.name)
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
-            pi = ratio_pct(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
             b.add(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", **out.cells(),
                   quantity=f"improvement ratio, {label}, N = {c.batch_size}", where="Section 5.2.1 (Figure 5.5)",
                   thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
-                  ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r["improvement_ratio"]),
+                  ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r),
                   rule="prediction", kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6",
                   thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
-                  expected_seeds=exp.seeds, interval=pi, interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]),
+                  expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
                   vacuous=frozen(r.get("theta_moved")))
         if "theta_final" in th:
             printed = np.asarray(th["theta_final"], dtype=float)
@@ -336,24 +340,22 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             thesis = th["improvement_ratio"]
-            pi, a_pi = ratio_pct(r["improvement_ratio"]), ratio_pct(ar and ar["improvement_ratio"])
             a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
             a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
                                pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True),
                                                      lambda x: pct(x, 1)),
-                               lambda *_, t=thesis, d=ar: one_run_ratio(t, d["improvement_ratio"]),
-                               authors_interval=a_pi,
-                               authors_interval_text=pi_text(a_pi, lambda x: f"{x:.1f}%", ar and ar["seeds"]),
+                               lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
+                               authors_interval=ratio_interval(ar), authors_interval_text=ratio_text(ar),
                                authors_vacuous=frozen(ar and ar.get("theta_moved")))
             out = output(c.name, "improvement_ratio") if output else None
             b.add(id=f"{table}/{c.name}/improvement-ratio", group=group, quantity=f"improvement ratio, {method}",
                   where=table.replace("table-", "Table "), thesis=pct(thesis),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
-                  ok=None if mean is None else one_run_ratio(thesis, r["improvement_ratio"]), rule="prediction",
+                  ok=None if mean is None else one_run_ratio(thesis, r), rule="prediction",
                   kind="one run", page=page, heading=heading, thesis_value=thesis, ours_value=mean, ours_ci95=ci,
-                  seeds=r["seeds"], expected_seeds=exp.seeds, interval=pi,
-                  interval_text=pi_text(pi, lambda x: f"{x:.1f}%", r["seeds"]), vacuous=frozen(r.get("theta_moved")),
+                  seeds=r["seeds"], expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
+                  vacuous=frozen(r.get("theta_moved")),
                   fields={"method": c.name, "quantity": "improvement_ratio"}, authors_note=authors_note,
                   slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
                   remark=_missing(out) or _also(also, other, "improvement_ratio", pct, f"{100 * thesis:.6g}", 100),
