@@ -152,3 +152,13 @@ def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status
     assert page.count("no information</span>") == 1
     summary = sc.summary_html(b.rows)
     assert "of which one of ours agrees without information" in summary
+
+
+def test_the_chapters_count_sentence_names_every_status_with_rows():
+    b = Builder()
+    b.add(id="c/ok", ok=True, **COMMON)
+    b.add(id="c/vacuous", ok=True, vacuous=FROZEN, **COMMON)
+    b.add(id="c/open", ok=False, **COMMON)
+    assert sc.counts_text(b.rows) == ("3 printed results: 1 reproduced, 1 that agree without carrying information, "
+                                      "1 open; in 1 of them one of our columns agrees with the print without "
+                                      "information")

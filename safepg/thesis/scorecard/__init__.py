@@ -48,6 +48,7 @@ from safepg.thesis.scorecard.export import (
     CSV_COLUMNS,
     TABLES,
     counts,
+    counts_text,
     read_csv,
     read_scorecard_json,
     write_scorecard,
@@ -94,7 +95,7 @@ __all__ = [
     "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "FROZEN_THETA", "GROUPS",
     "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RULES",
     "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS",
-    "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "group_html", "half_unit", "in_prediction",
-    "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
+    "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "counts_text", "group_html", "half_unit",
+    "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
     "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",
 ]

@@ -9,7 +9,17 @@ from pathlib import Path
 from typing import Any
 
 from safepg.thesis.scorecard.rows import scorecard
-from safepg.thesis.scorecard.rules import GROUPS, KIND_RULE, RULES, STATUS_RULE, STATUSES, Row
+from safepg.thesis.scorecard.rules import (
+    AUTHORS_ERROR_STATUS,
+    AUTHORS_STATUS,
+    GROUPS,
+    KIND_RULE,
+    RULES,
+    STATUS_RULE,
+    STATUSES,
+    VACUOUS_STATUS,
+    Row,
+)
 
 
 def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
@@ -20,6 +30,24 @@ def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
             out.setdefault(g, dict.fromkeys(STATUSES, 0))[r.status] += 1
     order = [g for g in (*GROUPS, "all") if g in out]
     return {g: out[g] for g in order}
+
+
+#: How a chapter's sentence names each status (:func:`counts_text`).
+STATUS_PHRASES = {"reproduced": "reproduced", AUTHORS_STATUS: "reproduced only with the authors' unprinted settings",
+                  AUTHORS_ERROR_STATUS: "reproduced only through an error in the authors' code",
+                  VACUOUS_STATUS: "that agree without carrying information",
+                  "differs (explained)": "that differ for a reason the book explains", "open": "open"}
+
+
+def counts_text(rows: Sequence[Row]) -> str:
+    """The rows' counts as the chapters say them: "12 printed results: 9 reproduced, 3 open" (statuses
+    with no row left out), and the rows flagged as agreeing without information on one of our columns."""
+    n = counts(rows).get("all", dict.fromkeys(STATUSES, 0))
+    parts = [f"{n[s]} {STATUS_PHRASES[s]}" for s in STATUSES if n[s]]
+    flagged = sum(bool(r.no_information) for r in rows)
+    also = (f"; in {flagged} of them one of our columns agrees with the print without information"
+            if flagged else "")
+    return f"{sum(n.values())} printed results: {', '.join(parts)}{also}"
 
 
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
