@@ -138,11 +138,13 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
 
 def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config) -> dict[str, np.ndarray]:
     """One curve of Figures 5.1-5.2: ours (seed mean and 95% band of the closed-form J of the
-    policy that generated trajectory T) and the authors' five-run mean, on their grid of T."""
+    policy that generated trajectory T; ``values``, each seed's) and the authors' five-run mean,
+    on their grid of T."""
     curve = authors.figure51_52_curves()[(config.estimator, config.bound, config.empirical_range, config.delta)]
     grid = curve["trajectories"].astype(np.int64)
-    mean, lo, hi = seed_band95(performance_on_grid(records[config.name], grid))
-    return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"]}
+    values = performance_on_grid(records[config.name], grid)
+    mean, lo, hi = seed_band95(values)
+    return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"], "values": values}
 
 
 def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
@@ -269,30 +271,52 @@ def lqg2d_binned(values: np.ndarray, width: int) -> np.ndarray:
         return np.nanmean(padded.reshape(v.shape[0], blocks, width), axis=2)
 
 
-def _lqg2d_iteration_figure(field: str, ours: Mapping[str, tuple[str, Sequence[LearningRecord]]],
-                            theirs: Mapping[str, tuple[str, AuthorsRun]], ylabel: str, log: bool,
-                            points: int = 150) -> Figure:
+def lqg2d_iteration_series(field: str, ours: Mapping[str, Sequence[LearningRecord]],
+                           theirs: Mapping[str, AuthorsRun], points: int = 150) -> dict[str, Any]:
+    """The curves of Figures 5.6-5.7's overlays: a per-iteration field in blocks of ``width`` iterations.
+
+    ``width`` = max(1, L // ``points``), L the longest of all the runs drawn, so it depends on
+    every curve of the figure. Returns ``width``, ``ours[key]`` (per-seed block means, (seeds,
+    blocks)), ``theirs[key]`` (the authors' run's block means) and ``x_ours[key]``, ``x_theirs[key]``,
+    each curve's block centres in iterations (1-based).
+    """
     column = {"batch_size": "N", "alpha": "alpha"}[field]
-    length = max([r.iterations for _, recs in ours.values() for r in recs]
-                 + [run.iterations for _, run in theirs.values()])
+    length = max([r.iterations for recs in ours.values() for r in recs] + [run.iterations for run in theirs.values()])
     width = max(1, length // points)
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for key, (label, recs) in ours.items():
+    binned_ours = {}
+    for key, recs in ours.items():
         values = np.full((len(recs), length), np.nan)
         for i, r in enumerate(recs):
             values[i, : r.iterations] = getattr(r, field)
-        binned = lqg2d_binned(values, width)
+        binned_ours[key] = lqg2d_binned(values, width)
+    binned_theirs = {key: lqg2d_binned(run[column], width)[0] for key, run in theirs.items()}
+    def centres(b: np.ndarray) -> np.ndarray:
+        return width * np.arange(b.shape[-1]) + (width + 1) / 2
+
+    return {"width": width, "ours": binned_ours, "theirs": binned_theirs,
+            "x_ours": {k: centres(b) for k, b in binned_ours.items()},
+            "x_theirs": {k: centres(b) for k, b in binned_theirs.items()}}
+
+
+def _lqg2d_iteration_figure(field: str, ours: Mapping[str, tuple[str, Sequence[LearningRecord]]],
+                            theirs: Mapping[str, tuple[str, AuthorsRun]], ylabel: str, log: bool,
+                            points: int = 150) -> Figure:
+    series = lqg2d_iteration_series(field, {k: recs for k, (_, recs) in ours.items()},
+                                    {k: run for k, (_, run) in theirs.items()}, points)
+    width = series["width"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for key, (label, recs) in ours.items():
+        binned = series["ours"][key]
         mean, lo, hi = seed_band95(binned)
         # Only where most seeds still run: with one or two seeds left the band is meaningless.
         few = np.sum(np.isfinite(binned), axis=0) < min(3, len(recs))
         mean[few] = lo[few] = hi[few] = np.nan
-        it = width * np.arange(mean.size) + (width + 1) / 2
+        it = series["x_ours"][key]
         color = _LQG2D_COLORS.get(key)
         ax.plot(it, mean, color=color, label=label, gid=f"ours:{key}", **_LQG2D_OURS)
         ax.fill_between(it, lo, hi, color=color, alpha=0.25, linewidth=0)
-    for key, (label, run) in theirs.items():
-        binned = lqg2d_binned(run[column], width)[0]
-        ax.plot(width * np.arange(binned.size) + (width + 1) / 2, binned, color=_lqg2d_dark(key), label=label,
+    for key, (label, _) in theirs.items():
+        ax.plot(series["x_theirs"][key], series["theirs"][key], color=_lqg2d_dark(key), label=label,
                 gid=f"authors:{key}", **_LQG2D_THEIRS)
     ax.set_xlabel("iteration" if width == 1 else f"iteration (means over blocks of {width})")
     ax.set_ylabel(ylabel)
@@ -368,6 +392,8 @@ def figure_5_8_overlay(records: Mapping[str, Sequence[LearningRecord]],
 
 #: Colours of the cart-pole overlay: ours (adaptive, fixed step) and the authors' runs beside them.
 _CARTPOLE_COLORS = {"adaptive": "#7d4fb0", "N=4000": "#d98c2b"}
+#: The authors' cart-pole run (:func:`safepg.thesis.authors.cartpole_runs`) each of our configs is drawn over.
+CARTPOLE_AUTHORS_RUN = {"adaptive": "adaptive", "N=4000": "fixed"}
 
 
 def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], grid: np.ndarray) -> dict[str, Any]:
@@ -384,7 +410,8 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     -------
     dict
         ``ours[name]``: ``mean``, ``lo``, ``hi`` (the seed mean of the batch-average return and its
-        95% Student-t band, :math:`\bar x \pm t_{0.975,n-1} s/\sqrt n`) and ``seeds``;
+        95% Student-t band, :math:`\bar x \pm t_{0.975,n-1} s/\sqrt n`), ``seeds`` and ``values``
+        (each seed's curve, (seeds, len(grid)));
         ``authors[name]``: ``trajectories`` (each batch's last trajectory) and ``J_hat``, from
         :func:`safepg.thesis.authors.cartpole_runs` (``"adaptive"`` and ``"N=4000"``, their fixed run).
     """
@@ -395,10 +422,10 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
         mean, lo, hi = seed_band95(values)
         one = np.sum(~np.isnan(values), axis=0) < 2  # no band drawn where fewer than two seeds remain
         lo[one] = hi[one] = np.nan
-        ours[name] = {"mean": mean, "lo": lo, "hi": hi, "seeds": len(recs)}
+        ours[name] = {"mean": mean, "lo": lo, "hi": hi, "seeds": len(recs), "values": values}
     runs = cartpole_runs()
     authors = {mine: {"trajectories": np.cumsum(runs[theirs]["N"]), "J_hat": np.asarray(runs[theirs]["J_hat"])}
-               for mine, theirs in (("adaptive", "adaptive"), ("N=4000", "fixed"))}
+               for mine, theirs in CARTPOLE_AUTHORS_RUN.items()}
     return {"grid": grid, "ours": ours, "authors": authors}
 
 
