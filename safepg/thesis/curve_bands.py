@@ -41,7 +41,8 @@ from safepg.thesis.experiments import get_experiment
 #: The scorecard's rule: a curve is reproduced when at least this share of it lies in our band.
 CURVE_SHARE = 0.9
 #: The experiments whose runs the scored figures draw (load these for :func:`curve_scores`).
-CURVE_EXPERIMENTS = ("table-5.2", "figures-5.5-5.6", "table-5.3", "table-5.3-authors", "table-5.4-authors-theta-star")
+CURVE_EXPERIMENTS = ("table-5.2", "figures-5.5-5.6", "table-5.3", "table-5.3-authors", "table-5.4",
+                     "table-5.4-authors-theta-star")
 #: Ranges listed by :func:`outside_sentence` before "and n more".
 LISTED_RANGES = 3
 #: How the authors' files write their numbers: Figures 5.1-5.2's curves with 6 decimals
@@ -294,12 +295,13 @@ def _binned_score(figure: str, curve: str, quantity: str, experiment: str, run: 
 
 
 def _cartpole_scores(records: Records) -> list[CurveScore]:
-    """Figure 5.9 against ``table-5.4-authors-theta-star``, up to Table 5.4's budget (the figure's x-axis)."""
-    name = "table-5.4-authors-theta-star"
-    recs = records.get(name, {})
+    """Figure 5.9 against ``table-5.4`` (the thesis's text) and ``table-5.4-authors-theta-star``, up to
+    Table 5.4's budget (the figure's x-axis)."""
     runs = authors.cartpole_runs()
     scores = []
-    for ours, theirs in overlays.CARTPOLE_AUTHORS_RUN.items():
+    for name, ours, theirs in ((n, o, t) for n in ("table-5.4", "table-5.4-authors-theta-star")
+                               for o, t in overlays.CARTPOLE_AUTHORS_RUN.items()):
+        recs = records.get(name, {})
         if not recs.get(ours):
             continue
         grid = np.cumsum(np.asarray(runs[theirs]["N"], dtype=float)).astype(np.int64)

@@ -16,6 +16,7 @@ from safepg.thesis.experiments import (
 )
 from safepg.thesis.scorecard.builder import Builder
 from safepg.thesis.scorecard.closed_forms import closed_form_rows
+from safepg.thesis.scorecard.curves import curve_rows
 from safepg.thesis.scorecard.links import BOOK
 from safepg.thesis.scorecard.rules import GROUPS, Row
 from safepg.thesis.scorecard.runs import run_rows
@@ -100,6 +101,7 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     b = Builder(book=book or BOOK)
     closed_form_rows(b)
     run_rows(b, exps, reps, recs, variant)
+    curve_rows(b, recs)
     order = {g: i for i, g in enumerate(GROUPS)}
     rows = sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group
     return rows if pages is None else _on_pages(rows, pages)

@@ -155,6 +155,14 @@ class Note:
     explains: bool = True
 
 
+#: The authors' curves of Figures 5.1 and 5.2 that leave our band.
+_FIGURES_5_1_5_2 = Note(
+    "Open: the authors' five-run mean leaves our band for a five-run mean, which is narrow (about ±0.07 at "
+    "J ≈ -54), over the ranges below; where Table 5.2's Ῡ of the same runs agrees with the print (every row but "
+    "the two theoretical-range ones), the gap is in the course of J, not in its average. What is missing: their "
+    "runs' own J curves (only their mean is committed), to tell one run's lead or lag from a difference of the "
+    "method.", "lqg1d", "Figures 5.1 and 5.2", explains=False)
+
 #: Explanations and notes, by row id or id prefix (``"table-5.1/"`` covers every cell).
 #: ``{...}`` fields are filled from the measured values (see :func:`safepg.thesis.scorecard.text.fill`).
 NOTES: dict[str, Note] = {
@@ -205,6 +213,8 @@ NOTES: dict[str, Note] = {
         "Open: ours also moves {extra} (by at most {extra_move:.0e}); the thesis's constants, which decide "
         "which component is updated, are not given; under the authors' settings (their per-batch constants) the "
         "components never updated are {authors_components}.", "cartpole", "Table 5.4", explains=False),
+    "figure-5.1/": _FIGURES_5_1_5_2,
+    "figure-5.2/": _FIGURES_5_1_5_2,
     # Errata rows carry their own sentence (safepg.thesis.errata.errata()); this gives their link.
     "theory/erratum": Note("", "errata", "Errata"),
 }
