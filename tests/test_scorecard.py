@@ -479,3 +479,13 @@ def test_rows_of_some_pages_equal_the_full_cards_rows(store):
         assert want and sc.scorecard(root, experiments=exps, pages=[page]) == want
     want = [r for r in rows if page_of[r.id] in ("lqg2d", "errata")]
     assert sc.scorecard(root, experiments=exps, pages=("lqg2d", "errata")) == want
+
+
+def test_every_authors_curve_is_a_figure_row(rows):
+    figures = [r for r in rows if r.kind == "whole curve"]
+    assert {r.id.split("/")[0] for r in figures} >= {f"figure-5.{k}" for k in (1, 2, 3, 4, 5, 6, 8, 9)}
+    assert len(figures) >= 7 and all(r.id.startswith("figure-5.") and r.rule == "curve-band" for r in figures)
+    for r in figures:
+        if r.judged_on == "ours":  # the 90% rule, applied to the share the row shows
+            assert (r.status == "reproduced") == (r.ours_value >= sc.CURVE_SHARE), r.id
+        assert "prediction band" in r.judged_interval_text or r.judged_on == "", r.id

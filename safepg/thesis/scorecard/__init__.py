@@ -43,6 +43,7 @@ Modules (their public names used outside the package are available here):
 
 from __future__ import annotations
 
+from safepg.thesis.curve_bands import CURVE_SHARE
 from safepg.thesis.scorecard.closed_forms import THEORY_LABELS
 from safepg.thesis.scorecard.export import (
     CSV_COLUMNS,
@@ -92,9 +93,9 @@ from safepg.thesis.scorecard.rules import (
 )
 
 __all__ = [
-    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "FROZEN_THETA", "GROUPS",
-    "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RULES",
-    "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS",
+    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "CURVE_SHARE", "FROZEN_THETA",
+    "GROUPS", "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS",
+    "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS",
     "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "counts_text", "group_html", "half_unit",
     "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
     "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",
