@@ -40,14 +40,47 @@ def test_closed_form_outcomes_count_what_the_record_shows():
     moved = np.diff(rec.theta[:, 0]) != 0
     assert out["updates"] == moved.sum() == 50
     assert out["lowered"] == int(np.sum(moved & (dJ < 0)))
+    assert out["lowered"] + out["raised"] + out["undetermined"] == out["updates"] and out["undetermined"] == 0
+    assert out["detection_floor"] == 0.0  # exact: nothing hides under a floor
     assert out["share_lowered"] == pytest.approx(out["lowered"] / 50)
+    assert out["share_lowered_upper95"] == safety.clopper_pearson_upper(out["lowered"], 50)
     assert out["unguarded"] == 0  # a fixed step is never marked unsafe
     # A record whose J falls at every move: every update lowered it.
     rec.J = -np.arange(rec.J.size, dtype=float)
-    assert safety.closed_form_outcomes(rec)["lowered"] == 50
+    low = safety.closed_form_outcomes(rec)
+    assert (low["lowered"], low["raised"], low["share_lowered_upper95"], low["largest_drop"]) == (50, 0, 1.0, 1.0)
     rec.J[3] = np.nan
     with pytest.raises(ValueError, match="record.J"):
         safety.closed_form_outcomes(rec)
+
+
+def test_closed_form_table_of_a_small_adaptive_lqg_run():
+    """An adaptive run on the 1-D LQG: its steps that did not move theta are no updates."""
+    from safepg import adaptive_pg
+
+    rec = adaptive_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, bound="chebyshev", delta=0.95, budget=60_000, rng=2)
+    out = safety.closed_form_outcomes(rec)
+    moved = np.diff(rec.theta[:, 0]) != 0
+    assert out["updates"] == moved.sum() > 0
+    assert out["lowered"] + out["raised"] + out["undetermined"] == out["updates"]
+    assert out["lowered"] == int(np.sum(np.diff(rec.J)[moved] < 0))
+    k = out["lowered"]
+    assert out["share_lowered_upper95"] == safety.clopper_pearson_upper(k, out["updates"])
+    assert out["share_lowered_upper95"] >= 1 - 0.05 ** (1 / out["updates"]) - 1e-15  # at least the k = 0 bound
+
+
+def test_closed_form_summary_of_a_J_sequence():
+    J = np.array([-10.0, -9.0, -9.5, -9.5, -8.0, -8.25])
+    out = safety.closed_form_summary(J)
+    # changes +1, -0.5, 0 (not a worsening: the thesis's improvement), +1.5, -0.25
+    assert (out["updates"], out["lowered"], out["raised"], out["undetermined"]) == (5, 2, 3, 0)
+    assert out["largest_drop"] == 0.5 and out["detection_floor"] == 0.0
+    assert out["share_lowered_upper95"] == safety.clopper_pearson_upper(2, 5)
+    assert safety.closed_form_summary(J, np.array([0, 3]))["lowered"] == 0
+    with pytest.raises(ValueError, match="^updates"):
+        safety.closed_form_summary(J, np.array([5]))
+    with pytest.raises(ValueError, match="^J"):
+        safety.closed_form_summary(np.array([[1.0, 2.0]]))
 
 
 def test_theorem_assumptions_tell_the_thesis_text_from_the_authors_settings():

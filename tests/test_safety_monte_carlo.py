@@ -1,4 +1,7 @@
-"""The Monte Carlo safety measurement: paired rollouts, intervals and outcomes against a closed form."""
+"""The Monte Carlo safety measurement: paired rollouts, intervals and outcomes against a closed form;
+the per-run summary (counts, Clopper-Pearson bound, detection floor)."""
+
+import json
 
 import numpy as np
 import pytest
@@ -62,6 +65,17 @@ def test_cart_pole_pairs_use_the_kernel_with_the_same_random_numbers():
     assert np.array_equal(a, sim.rewards.sum(axis=1))
 
 
+def test_discounted_cart_pole_returns_come_from_the_episode_lengths():
+    # The thesis's task (gamma = 0.99): the kernel's episode lengths L give sum_{t < L} gamma^t.
+    env = CartPole.thesis_doubled()
+    theta = np.array([-0.9, 2.1, 3.5, 7.25])
+    a, b = safety.paired_returns(env, theta, theta + [0.0, 0.0, 0.3, 0.0], 1.0, 300, 5)
+    for th, got in ((theta, a), (theta + [0.0, 0.0, 0.3, 0.0], b)):
+        sim = env.simulate(LinearGaussianPolicy(th[None, :], 1.0), 300, 5)
+        np.testing.assert_allclose(got, sim.discounted_returns(), rtol=0, atol=1e-11)
+    assert env.gamma == 0.99 and a.max() <= (1 - 0.99 ** env.horizon) / 0.01 + 1e-9
+
+
 def test_steps_lived_are_counted(outcomes):
     # The LQG rollouts run to the horizon; the cart-pole's end when they fall, one reward a step.
     assert outcomes.steps == 2 * ENV.horizon * outcomes.rollouts.sum()
@@ -99,13 +113,6 @@ def test_cache_returns_the_stored_measurement(tmp_path, monkeypatch):
         safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **{**kw, "seed": 3})
 
 
-def test_spread_updates():
-    assert safety.spread_updates(250, 5).tolist() == [0, 62, 124, 187, 249]
-    assert safety.spread_updates(3, 10).tolist() == [0, 1, 2]
-    with pytest.raises(ValueError, match="count"):
-        safety.spread_updates(3, 0)
-
-
 def test_normal_quantile():
     assert safety.normal_quantile("0.01") == pytest.approx(2.5758293035489004, abs=1e-15)
     assert safety.normal_quantile("0.05") == pytest.approx(1.959963984540054, abs=1e-15)
@@ -113,13 +120,114 @@ def test_normal_quantile():
         safety.normal_quantile("1.5")
 
 
-def test_measure_runs_joins_the_runs(tmp_path):
-    runs = [THETAS[:5], THETAS[4:]]
-    out = safety.measure_runs(ENV, runs, 1.0, 2, tmp_path, looks=(300, 600), seed=4)
-    assert out.updates.tolist() == [0, 3, 0, 4]
-    one = safety.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 4]), (300, 600), seed=4)
-    assert out.change[2:].tolist() == one.change.tolist()
+def test_measure_runs_takes_every_update_that_moved_theta(tmp_path):
+    runs = [THETAS[:5], THETAS[4:]]  # the second run holds the update that does not move theta (its k = 2)
+    out = safety.measure_runs(ENV, runs, 1.0, tmp_path, looks=(300, 600), seed=4)
+    assert [o.updates.tolist() for o in out] == [[0, 1, 2, 3], [0, 1, 3, 4]]
+    one = safety.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 1, 3, 4]), (300, 600), seed=4)
+    assert out[1].to_json() == one.to_json()
+    assert len(list(tmp_path.glob("*.json"))) == 2  # one file per run, read back above
+    for o, T in zip(out, runs):  # the counts add up to the run's updates
+        c = o.counts()
+        assert c["lowered"] + c["raised"] + c["undetermined"] == c["updates"] == safety.moved_updates(T).size
+    pooled = safety.MonteCarloOutcomes.join(out)
+    assert pooled.updates.tolist() == [0, 1, 2, 3, 0, 1, 3, 4] and pooled.steps == out[0].steps + out[1].steps
+    # A run that never moved: nothing measured, nothing stored (the time budget reads every stored file).
+    still = safety.measure_runs(ENV, [np.repeat(THETAS[:1], 4, axis=0)], 1.0, tmp_path, looks=(300, 600))
+    assert still[0].updates.size == 0 and still[0].counts()["share_lowered_upper95"] is None
     assert len(list(tmp_path.glob("*.json"))) == 2
+    with pytest.raises(ValueError, match="looks"):
+        safety.MonteCarloOutcomes.join([out[0], safety.monte_carlo_changes(ENV, THETAS, 1.0, [0], looks=(300,))])
+
+
+def test_parallel_measurement_is_the_serial_one(tmp_path):
+    ks = np.array([0, 2, 3, 5, 6, 8])
+    serial = safety.monte_carlo_changes(ENV, THETAS, 1.0, ks, looks=(300, 1200), seed=5)
+    par = safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300, 1200), seed=5, jobs=2)
+    assert par.to_json() == serial.to_json()
+    stored = json.loads(next(tmp_path.glob("*.json")).read_text())
+    assert stored["seconds"] > 0 and stored["outcomes"]["steps"] == serial.steps > 0  # what the budget reads
+    with pytest.raises(ValueError, match="jobs"):
+        safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300,), jobs=0)
+
+
+def test_counts_add_up_on_a_cart_pole_measurement():
+    """A small real measurement: an authors' adaptive update and a fixed-step one, on their doubled pole."""
+    from safepg.thesis import authors
+
+    env = CartPole.thesis_doubled(gamma=1.0, angle_threshold_deg=12.0)
+    runs = authors.cartpole_runs()
+    thetas = np.concatenate([runs["adaptive"]["theta"][:3], runs["fixed"]["theta"][:3]])
+    out = safety.monte_carlo_changes(env, thetas, 1.0, looks=(300, 600), seed=1)
+    c = out.counts()
+    assert c["lowered"] + c["raised"] + c["undetermined"] == c["updates"] == 5
+    assert c["share_lowered_upper95"] == safety.clopper_pearson_upper(c["lowered"] + c["undetermined"], 5)
+    hidden = [-lo for lo, o in zip(out.lower, out.outcome) if o == "undetermined"]
+    assert c["detection_floor"] == max([0.0, *hidden])
+
+
+def _synthetic(lower, upper):
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    outcome = np.where(upper < 0, "lowered", np.where(lower > 0, "raised", "undetermined"))
+    return safety.MonteCarloOutcomes(np.arange(lower.size), (lower + upper) / 2, lower, upper,
+                                     np.full(lower.size, 64_000), outcome, (4000, 16_000, 64_000), "0.01", 1)
+
+
+def test_summary_of_synthetic_outcomes():
+    out = _synthetic([0.1, -0.5, -0.003, -0.02, 0.2, -0.001], [0.3, -0.1, 0.004, 0.01, 0.5, 0.0005])
+    c = out.counts()
+    assert (c["updates"], c["lowered"], c["raised"], c["undetermined"]) == (6, 1, 2, 3)
+    # The largest decrease an undetermined interval leaves room for: -lower of the third, 0.02 steps.
+    assert c["detection_floor"] == 0.02
+    assert c["share_lowered_upper95"] == safety.clopper_pearson_upper(4, 6)
+    # Only raised updates: no floor, and the bound is the k = 0 one, 1 - 0.05^(1/n).
+    clean = _synthetic([0.1, 0.2, 0.01], [0.3, 0.4, 0.02]).counts()
+    assert clean["detection_floor"] == 0.0 and clean["undetermined"] == 0
+    assert clean["share_lowered_upper95"] == pytest.approx(1 - 0.05 ** (1 / 3), abs=1e-15)
+    # An undetermined interval entirely above -0: hides no decrease.
+    assert _synthetic([0.0, 0.1], [0.2, 0.3]).counts()["detection_floor"] == 0.0
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 16, 30, 250, 1000])
+def test_clopper_pearson_upper_is_scipy_beta_quantile(n):
+    from scipy.stats import beta
+
+    for k in sorted({0, 1, n // 3, n // 2, n - 1, n}):
+        expected = 1.0 if k == n else beta.ppf(0.95, k + 1, n - k)
+        assert safety.clopper_pearson_upper(k, n) == pytest.approx(expected, abs=1e-10), (k, n)
+    expected = beta.ppf(0.99, 2, n - 1) if n > 1 else 1.0
+    assert safety.clopper_pearson_upper(1, n, "0.99") == pytest.approx(expected, abs=1e-10)
+
+
+def test_clopper_pearson_upper_values_and_refusals():
+    assert safety.clopper_pearson_upper(0, 16) == pytest.approx(0.1707497, abs=1e-7)  # 0 of 16: still 17%
+    assert safety.clopper_pearson_upper(7, 7) == 1.0
+    assert safety.clopper_pearson_upper(0, 1) == pytest.approx(0.95, abs=1e-15)
+    with pytest.raises(ValueError, match="^n must"):
+        safety.clopper_pearson_upper(0, 0)
+    with pytest.raises(ValueError, match="^k must"):
+        safety.clopper_pearson_upper(5, 4)
+    with pytest.raises(ValueError, match="^level must"):
+        safety.clopper_pearson_upper(1, 4, "1.5")
+
+
+def test_safety_summary_refuses_bad_counts():
+    assert safety.safety_summary(0, 0)["share_lowered_upper95"] is None  # no update: no bound
+    with pytest.raises(ValueError, match="^lowered"):
+        safety.safety_summary(-1, 3)
+    with pytest.raises(ValueError, match="^undetermined"):
+        safety.safety_summary(0, 3, 1.5)
+    with pytest.raises(ValueError, match="^detection_floor"):
+        safety.safety_summary(0, 3, 0, 0.1)  # nothing undetermined hides nothing
+    with pytest.raises(ValueError, match="^detection_floor"):
+        safety.safety_summary(0, 3, 1, float("nan"))
+
+
+def test_moved_updates():
+    assert safety.moved_updates(THETAS).tolist() == [0, 1, 2, 3, 4, 5, 7, 8]
+    assert safety.moved_updates(np.array([[1.0, 2.0], [1.0, 2.0], [1.0, 2.5]])).tolist() == [1]
+    with pytest.raises(ValueError, match="^thetas"):
+        safety.moved_updates(np.zeros((2, 2, 2)))
 
 
 def test_theorem_assumptions_name_the_two_discounts():

@@ -460,21 +460,24 @@ def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], lab
 def figure_cartpole_safety(measured: Mapping[str, Any]) -> Figure:
     """Each measured update's change of J with its interval (:func:`safepg.thesis.safety.measure_runs`).
 
-    ``measured`` maps a run's label to its :class:`~safepg.thesis.safety.MonteCarloOutcomes`; labels
-    with "adaptive" go to the left panel, the others (the fixed-step runs) to the right one, each on
-    its own scale. Within a panel the runs follow each other, updates in their order.
+    ``measured`` maps a label to a :class:`~safepg.thesis.safety.MonteCarloOutcomes` (one run, or
+    several joined by :meth:`~safepg.thesis.safety.MonteCarloOutcomes.join`); labels with
+    "adaptive" go to the left panel, the others (the fixed-step runs) to the right one, each on
+    its own scale. Within a panel the labels follow each other, updates in their order; labels
+    without updates are left out.
     """
     fig, axes = plt.subplots(1, 2, figsize=(8, 3.6))
-    colours = ("#7d4fb0", "#2e9e5b")
+    colours = ("#7d4fb0", "#2e9e5b", "#d98c2b", "#3b6fb6", "#c0392b", "#555555")
     for ax, adaptive in zip(axes, (True, False)):
         x0 = 0
-        names = [n for n in measured if ("adaptive" in n) == adaptive]
+        names = [n for n in measured if ("adaptive" in n) == adaptive and measured[n].change.size]
         for name, col in zip(names, colours):
             out = measured[name]
             x = x0 + np.arange(out.change.size)
-            ax.errorbar(x, out.change, yerr=[out.change - out.lower, out.upper - out.change], fmt="o", markersize=3,
-                        color=col, elinewidth=1, capsize=0, label=name)
-            x0 += out.change.size + 2
+            ax.errorbar(x, out.change, yerr=[out.change - out.lower, out.upper - out.change], fmt="o",
+                        markersize=3 if out.change.size <= 50 else 1.5, color=col,
+                        elinewidth=1 if out.change.size <= 50 else 0.4, capsize=0, label=name)
+            x0 += out.change.size + max(2, out.change.size // 50)
         ax.axhline(0, color="black", linewidth=0.8)
         ax.set_xticks([])
         ax.set_xlabel("measured updates, in order")

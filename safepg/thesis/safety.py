@@ -15,7 +15,10 @@ the step :math:`\Lambda^*` does not lower the performance :math:`J`, provided th
 counts, from a learning record, how many updates lowered the closed-form :math:`J`;
 :func:`monte_carlo_changes` measures the same with a Monte Carlo :math:`J` on tasks without a closed
 form (the cart-pole), with common random numbers and a 99% interval per update
-(:func:`cached_monte_carlo_changes` keeps the result in the results folder).
+(:func:`cached_monte_carlo_changes` keeps the result in the results folder, :func:`measure_runs`
+takes every update of each run). Both summaries give, per run, the updates that lowered, raised or
+left undetermined :math:`J`, the one-sided 95% Clopper-Pearson bound on the share of updates that
+lower it (:func:`clopper_pearson_upper`) and the detection floor of the Monte Carlo measurement.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from safepg import portable
+from safepg.envs.cartpole import CartPole
 from safepg.learning import LearningRecord
 from safepg.policies import LinearGaussianPolicy
 from safepg.runner import RESULTS_VERSION, RunConfig
@@ -81,25 +85,190 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
     return rows
 
 
+@cache
+def clopper_pearson_upper(k: int, n: int, level: str = "0.95") -> float:
+    r"""The one-sided Clopper-Pearson upper bound on a binomial share, ``k`` of ``n``.
+
+    The largest share :math:`p` under which ``k`` or fewer of ``n`` independent trials succeed
+    with probability at least :math:`1 - \text{level}`:
+
+    .. math::
+
+        p_U = \sup\{p : P(X \le k \mid n, p) \ge 1 - \text{level}\}, \qquad
+        X \sim \mathrm{Binomial}(n, p),
+
+    that is the ``level`` quantile of :math:`\mathrm{Beta}(k + 1, n - k)`,
+    :math:`I_{p_U}(k + 1, n - k) = \text{level}` with :math:`I` the regularised incomplete beta
+    function, and :math:`p_U = 1` for :math:`k = n`. For :math:`k = 0` it is
+    :math:`1 - (1 - \text{level})^{1/n}` (about :math:`3/n` at level 0.95). Whatever the true
+    share, the bound lies above it with probability at least ``level``.
+
+    Computed with mpmath (software arithmetic, 40 digits: the binomial sum :math:`P(X \le k)`
+    and a bisection of fixed length on it), so the same to the last bit on every CPU.
+
+    Parameters
+    ----------
+    k : int
+        Successes (here: updates that lowered J, or may have), ``0 <= k <= n``.
+    n : int
+        Trials (updates), ``n >= 1``.
+    level : str
+        The confidence level, a decimal string in (0, 1).
+    """
+    import mpmath
+
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= n:
+        raise ValueError(f"k must be an integer in [0, n = {n}], got {k!r}")
+    with mpmath.workdps(40):
+        q = mpmath.mpf(level)
+        if not 0 < q < 1:
+            raise ValueError(f"level must be in (0, 1), got {level!r}")
+        if k == n:
+            return 1.0
+        if k == 0:
+            return float(1 - mpmath.power(1 - q, mpmath.mpf(1) / n))
+        lo, hi = mpmath.mpf(0), mpmath.mpf(1)
+        for _ in range(120):  # P(X <= k) falls as p grows: halve [lo, hi] to 2^-120
+            mid = (lo + hi) / 2
+            if _binomial_cdf(k, n, mid) > 1 - q:
+                lo = mid
+            else:
+                hi = mid
+        return float(hi)
+
+
+def _binomial_cdf(k: int, n: int, p: Any) -> Any:
+    r""":math:`P(X \le k)` for :math:`X \sim \mathrm{Binomial}(n, p)`, an mpmath number, ``0 < p < 1``.
+
+    The sum of the :math:`\binom{n}{i} p^i (1-p)^{n-i}` over the shorter side (:math:`i \le k`, or
+    one minus :math:`i > k`), each term from the previous one by the ratio of consecutive terms.
+    """
+    import mpmath
+
+    r = p / (1 - p)
+    if k <= n // 2:
+        term = mpmath.power(1 - p, n)  # i = 0
+        total = term
+        for i in range(k):
+            term = term * (n - i) / (i + 1) * r
+            total += term
+        return total
+    term = mpmath.power(p, n)  # i = n
+    total = term
+    for i in range(n, k + 1, -1):
+        term = term * i / (n - i + 1) / r
+        total += term
+    return 1 - total
+
+
+def safety_summary(lowered: int, raised: int, undetermined: int = 0, detection_floor: float = 0.0,
+                   level: str = "0.95") -> dict[str, Any]:
+    r"""One run's updates: how many lowered, raised or left undetermined J, and the bound on the share.
+
+    An *undetermined* update (a Monte Carlo interval that contains 0) may have lowered J, so the
+    upper bound counts it as lowered:
+
+    .. math::
+
+        \text{share\_lowered\_upper95} = p_U(\text{lowered} + \text{undetermined},\ \text{updates})
+
+    (:func:`clopper_pearson_upper`), the largest share of updates that lower J, for updates drawn
+    as these were, consistent at ``level`` with the counts; with no update at all it is ``None``.
+    ``detection_floor`` says how large a decrease an undetermined update could hide.
+
+    Parameters
+    ----------
+    lowered, raised, undetermined : int
+        The counts (``updates`` is their sum).
+    detection_floor : float
+        The largest decrease of J an undetermined update could hide (0 when there are none).
+    level : str
+        The bound's confidence level.
+
+    Returns
+    -------
+    dict
+        ``updates``, ``lowered``, ``raised``, ``undetermined``, ``share_lowered_upper95``,
+        ``detection_floor``.
+    """
+    for name, v in (("lowered", lowered), ("raised", raised), ("undetermined", undetermined)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise ValueError(f"{name} must be an integer >= 0, got {v!r}")
+    if not (math.isfinite(detection_floor) and detection_floor >= 0):
+        raise ValueError(f"detection_floor must be finite and >= 0, got {detection_floor!r}")
+    if undetermined == 0 and detection_floor != 0:
+        raise ValueError(f"detection_floor must be 0 without undetermined updates, got {detection_floor!r}")
+    n = int(lowered + raised + undetermined)
+    bound = clopper_pearson_upper(int(lowered + undetermined), n, level) if n else None
+    return {"updates": n, "lowered": int(lowered), "raised": int(raised), "undetermined": int(undetermined),
+            "share_lowered_upper95": bound, "detection_floor": float(detection_floor)}
+
+
+def moved_updates(thetas: np.ndarray) -> np.ndarray:
+    """The updates that moved theta: every k with theta[k + 1] != theta[k] in some component.
+
+    ``thetas`` is (I + 1, m) (or (I + 1,)), the parameters in the order visited. A step of size 0
+    (no update taken, Assumption 4.2.7 failing) is no update: it cannot change J.
+    """
+    T = np.asarray(thetas, dtype=float)
+    if T.ndim not in (1, 2) or T.shape[0] < 1:
+        raise ValueError(f"thetas must be (I + 1, m) parameters, got shape {T.shape}")
+    T = T.reshape(T.shape[0], -1)
+    return np.flatnonzero(np.any(T[1:] != T[:-1], axis=1))
+
+
+def closed_form_summary(J: np.ndarray, updates: np.ndarray | None = None) -> dict[str, Any]:
+    r"""How the updates changed a closed-form J, exactly: :func:`safety_summary` of its changes.
+
+    Update k changes J by :math:`\Delta J_k = J_{k+1} - J_k`. It *lowered* J when
+    :math:`\Delta J_k < 0` and *raised* it otherwise (:math:`\Delta J_k \ge 0`: it did not
+    worsen the performance, the thesis's improvement, Section 5.1); none is undetermined and the
+    detection floor is 0.
+
+    Parameters
+    ----------
+    J : array (I + 1,)
+        The closed-form J at each visited theta.
+    updates : int array or None
+        The updates to count (default: all I; :func:`moved_updates` for those that moved theta).
+
+    Returns
+    -------
+    dict
+        :func:`safety_summary`'s fields, plus ``largest_drop`` (the largest decrease, 0 if none).
+    """
+    J = np.asarray(J, dtype=float)
+    if J.ndim != 1 or not np.all(np.isfinite(J)):
+        raise ValueError("J must be a finite closed-form J per visited theta")
+    dJ = np.diff(J)
+    ks = np.arange(dJ.size) if updates is None else np.asarray(updates, dtype=int)
+    if ks.size and (ks.min() < 0 or ks.max() >= dJ.size):
+        raise ValueError(f"updates must lie in [0, {dJ.size - 1}], got {ks.min()}..{ks.max()}")
+    lowered = dJ[ks] < 0
+    return {**safety_summary(int(lowered.sum()), int(ks.size - lowered.sum())),
+            "largest_drop": float(-dJ[ks][lowered].min()) if lowered.any() else 0.0}
+
+
 def closed_form_outcomes(record: LearningRecord) -> dict[str, Any]:
     """How the updates of ``record`` changed the closed-form J (``record.J``, one per theta row).
 
-    Counts only updates that moved theta. Returns ``updates`` (their number), ``lowered``
-    (those with a strictly lower J after than before), ``share_lowered``,
-    ``unguarded`` (moves taken where eps >= |g_k|, ``record.safe`` False),
-    ``lowered_unguarded`` and ``largest_drop`` (the largest decrease of J, 0 if none).
+    Counts only updates that moved theta (:func:`moved_updates`). Returns
+    :func:`closed_form_summary`'s fields (``updates``, ``lowered``, ``raised``, ``undetermined`` = 0,
+    ``share_lowered_upper95``, ``detection_floor`` = 0, ``largest_drop``), plus ``share_lowered``,
+    ``unguarded`` (moves taken where eps >= |g_k|, ``record.safe`` False) and ``lowered_unguarded``.
     """
     J = np.asarray(record.J, dtype=float)
     if J.shape != (record.theta.shape[0],) or not np.all(np.isfinite(J)):
         raise ValueError("record.J must hold a finite closed-form J per theta row")
-    moved = np.any(np.diff(record.theta, axis=0) != 0, axis=1)
-    dJ = np.diff(J)
-    lowered = moved & (dJ < 0)
-    unguarded = moved & ~np.asarray(record.safe, dtype=bool)
-    n = int(moved.sum())
-    return {"updates": n, "lowered": int(lowered.sum()), "share_lowered": lowered.sum() / n if n else 0.0,
-            "unguarded": int(unguarded.sum()), "lowered_unguarded": int((lowered & unguarded).sum()),
-            "largest_drop": float(-dJ[lowered].min()) if lowered.any() else 0.0}
+    ks = moved_updates(record.theta)
+    out = closed_form_summary(J, ks)
+    lowered = np.diff(J)[ks] < 0
+    unguarded = ~np.asarray(record.safe, dtype=bool)[ks]
+    n = out["updates"]
+    return {**out, "share_lowered": out["lowered"] / n if n else 0.0, "unguarded": int(unguarded.sum()),
+            "lowered_unguarded": int((lowered & unguarded).sum())}
 
 
 # ---------------------------------------------------------------- Monte Carlo J (cart-pole)
@@ -113,6 +282,9 @@ def closed_form_outcomes(record: LearningRecord) -> dict[str, Any]:
 #: Rollouts per policy after each look of :func:`monte_carlo_changes` (cumulative): an update
 #: whose interval still contains 0 gets fresh rollouts up to the next count.
 MC_LOOKS = (4_000, 16_000, 64_000)
+#: The looks for our own runs (thousands of updates: with the authors' runs at :data:`MC_LOOKS`,
+#: 100 s on 2 cores from empty): a smaller last look, hence a larger detection floor.
+MC_LOOKS_OUR_RUNS = (1_000, 2_000)
 #: Probability that an update's interval misses its true change, over all the looks together.
 MC_ALPHA = "0.01"
 
@@ -153,21 +325,41 @@ class MonteCarloOutcomes:
     alpha: str
     steps: int = 0
 
-    def counts(self) -> dict[str, Any]:
-        """``updates``, ``lowered``, ``raised``, ``undetermined``, the total ``rollouts`` (both policies
-        of every update) and the median and largest interval ``half_width``."""
+    def counts(self, level: str = "0.95") -> dict[str, Any]:
+        r"""The run's :func:`safety_summary` (``updates``, ``lowered``, ``raised``, ``undetermined``,
+        ``share_lowered_upper95``, ``detection_floor``), the total ``rollouts`` (both policies of
+        every update) and the median and largest interval ``half_width``.
+
+        The detection floor is the largest decrease of J an undetermined update could hide,
+        :math:`\max_k \max(0, -\text{lower}_k)` over the undetermined updates (0 when none), in
+        the units of J (steps of episode length on the cart-pole).
+        """
         half = (self.upper - self.lower) / 2
-        return {"updates": int(self.updates.size),
-                **{k: int(np.count_nonzero(self.outcome == k)) for k in ("lowered", "raised", "undetermined")},
+        n = {k: int(np.count_nonzero(self.outcome == k)) for k in ("lowered", "raised", "undetermined")}
+        hidden = -self.lower[self.outcome == "undetermined"]
+        floor = max(0.0, float(hidden.max())) if hidden.size else 0.0
+        return {**safety_summary(n["lowered"], n["raised"], n["undetermined"], floor, level),
                 "rollouts": int(2 * self.rollouts.sum()),
                 "median_half_width": float(np.median(half)) if half.size else float("nan"),
                 "largest_half_width": float(half.max()) if half.size else float("nan")}
+
+    @classmethod
+    def join(cls, parts: Sequence[MonteCarloOutcomes]) -> MonteCarloOutcomes:
+        """Several measurements in one, in order (``updates`` keeps each part's own indices); the
+        parts must share their looks and alpha."""
+        if not parts:
+            raise ValueError("parts must hold at least one measurement")
+        if any((p.looks, p.alpha) != (parts[0].looks, parts[0].alpha) for p in parts):
+            raise ValueError("parts must share their looks and alpha")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts])
+                     for f in ("updates", "change", "lower", "upper", "rollouts", "outcome")),
+                   looks=parts[0].looks, alpha=parts[0].alpha, steps=sum(p.steps for p in parts))
 
     def to_json(self) -> dict[str, Any]:
         """JSON-ready form (:meth:`from_json` reads it back)."""
         return {"updates": self.updates.tolist(), "change": self.change.tolist(), "lower": self.lower.tolist(),
                 "upper": self.upper.tolist(), "rollouts": self.rollouts.tolist(), "outcome": self.outcome.tolist(),
-                "looks": list(self.looks), "alpha": self.alpha, "steps": self.steps}
+                "looks": list(self.looks), "alpha": self.alpha, "steps": int(self.steps)}
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> MonteCarloOutcomes:
@@ -183,25 +375,48 @@ def paired_returns(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: fl
 
     Both policies :math:`\mathcal N(\theta^\top\phi(s), \sigma^2)` are simulated by the task with the
     same ``seed``: the same initial states and the same standard-normal action noise. The return is
-    the task's objective, :math:`\sum_t \gamma^t r_t` with its ``gamma``; at ``gamma == 1`` a task
-    with a fused ``gradient_batch`` (the cart-pole, whose second output is the undiscounted return)
-    is run through it, which draws the same random numbers as ``simulate`` and is faster.
+    the task's objective, :math:`\sum_t \gamma^t r_t` with its ``gamma``. The cart-pole, rewarded 1
+    per step lived, is run through its fused ``gradient_batch`` (the same random numbers as
+    ``simulate``, and faster), whose second output is each episode's length :math:`L`; its return
+    is then :math:`\sum_{t < L} \gamma^t` (:math:`L` itself at :math:`\gamma = 1`).
 
     Returns
     -------
     (ndarray, ndarray)
         The (n,) returns under ``theta_a`` and under ``theta_b``.
     """
-    out = []
+    a, b, _ = _paired(env, theta_a, theta_b, sigma, n, seed)
+    return a, b
+
+
+def _paired(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: float, n: int,
+            seed: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """:func:`paired_returns` and the trajectory-steps its rollouts lived (for the time budget):
+    the episode lengths on the cart-pole, the horizon for every rollout otherwise."""
+    out, steps = [], 0
     for theta in (theta_a, theta_b):
         th = np.asarray(theta, dtype=float)
         policy = LinearGaussianPolicy(th.reshape(getattr(env, "action_dim", getattr(env, "dim", 1)), -1), sigma)
-        if _fused_returns(env):
-            # The returns alone: no baseline to form (the returns are the same either way).
-            out.append(np.asarray(env.gradient_batch(policy, n, seed, baseline=False)[1], dtype=float))
+        if isinstance(env, CartPole):
+            # The episode lengths alone: no baseline to form (the returns are the same either way).
+            lengths = np.asarray(env.gradient_batch(policy, n, seed, baseline=False)[1])
+            steps += int(lengths.sum())
+            out.append(_discounted_sums(float(env.gamma), int(env.horizon))[lengths.astype(np.int64)])
         else:
             out.append(env.simulate(policy, n, seed).discounted_returns())
-    return out[0], out[1]
+            steps += int(env.horizon) * int(n)
+    return out[0], out[1], steps
+
+
+@cache
+def _discounted_sums(gamma: float, horizon: int) -> np.ndarray:
+    r""":math:`\sum_{t < L} \gamma^t` for :math:`L = 0, \dots, H`, summed in order (exact integers at
+    :math:`\gamma = 1`)."""
+    table = np.zeros(horizon + 1)
+    for t, p in enumerate(portable.powers(gamma, horizon)):
+        table[t + 1] = table[t] + p
+    table.flags.writeable = False
+    return table
 
 
 @cache
@@ -229,20 +444,6 @@ def _interval(d: np.ndarray, tails: str) -> tuple[float, float, float]:
     return m, m - h, m + h
 
 
-def _fused_returns(env: Any) -> bool:
-    """Whether :func:`paired_returns` reads the returns off a fused ``gradient_batch``: the
-    undiscounted returns of the cart-pole, one reward per step lived."""
-    return getattr(env, "gamma", None) == 1.0 and hasattr(env, "gradient_batch")
-
-
-def rollout_steps(env: Any, returns_a: np.ndarray, returns_b: np.ndarray) -> int:
-    """Trajectory-steps lived by the rollouts of :func:`paired_returns` (for the time budget):
-    the returns themselves on the fused path, the horizon for every rollout otherwise."""
-    if _fused_returns(env):
-        return int(returns_a.sum() + returns_b.sum())
-    return int(env.horizon) * (returns_a.size + returns_b.size)
-
-
 def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.ndarray | None = None,
                         looks: tuple[int, ...] = MC_LOOKS, alpha: str = MC_ALPHA, seed: int = 0) -> MonteCarloOutcomes:
     r"""Did each update lower J? Paired Monte Carlo estimates with a sequential rollout count.
@@ -259,7 +460,7 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
     Parameters
     ----------
     env : task
-        ``simulate(policy, n, rng)`` and ``gamma`` (optionally a fused ``gradient_batch``).
+        ``simulate(policy, n, rng)`` and ``gamma`` (the cart-pole through its fused ``gradient_batch``).
     thetas : array_like, shape (I + 1, m)
         The parameters in the order visited (a record's ``theta``).
     sigma : float
@@ -290,8 +491,8 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
         for i in np.flatnonzero(~done):
             k = int(ks[i])
             block_seed = int(np.random.SeedSequence([seed, k, j]).generate_state(1)[0])
-            a, b = paired_returns(env, T[k], T[k + 1], sigma, n - used[i], block_seed)
-            steps += rollout_steps(env, a, b)
+            a, b, lived = _paired(env, T[k], T[k + 1], sigma, n - used[i], block_seed)
+            steps += lived
             diffs[i].append(b - a)
             used[i] = n
             result[i] = _interval(np.concatenate(diffs[i]), tails)
@@ -301,23 +502,26 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
                               tuple(int(n) for n in looks), alpha, steps)
 
 
-def spread_updates(iterations: int, count: int) -> np.ndarray:
-    """``count`` updates spread evenly over a run of ``iterations`` updates (the first and last included)."""
-    if iterations < 1 or count < 1:
-        raise ValueError(f"iterations and count must be >= 1, got {iterations} and {count}")
-    return np.unique(np.round(np.linspace(0, iterations - 1, min(count, iterations))).astype(int))
-
-
 def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma: float,
                                updates: np.ndarray | None = None, looks: tuple[int, ...] = MC_LOOKS,
-                               alpha: str = MC_ALPHA, seed: int = 0) -> MonteCarloOutcomes:
+                               alpha: str = MC_ALPHA, seed: int = 0, jobs: int = 1) -> MonteCarloOutcomes:
     """:func:`monte_carlo_changes`, stored in ``folder`` under a key of all its inputs.
 
     The file ``<key>.json`` is written atomically (a temporary file renamed over it, as the run
     store does); a file that cannot be read, or was made by other inputs, is computed again.
+    It also records the ``seconds`` the measurement took (wall time; the time budget reads them,
+    with the ``steps`` its rollouts lived). Without updates nothing is simulated or stored.
+
+    ``jobs`` > 1 measures the updates in that many joblib processes, update ``i`` of the list in
+    process ``i % jobs``. Each update's rollouts are seeded by the update and the look alone, so
+    the outcomes are the same for any ``jobs``; it is not part of the key.
     """
     T = np.ascontiguousarray(np.asarray(thetas, dtype=float))
     ks = np.arange(T.shape[0] - 1) if updates is None else np.asarray(updates, dtype=int)
+    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
+        raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
+    if ks.size == 0:
+        return monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
     blob = json.dumps([repr(env), hashlib.sha256(T.tobytes()).hexdigest(), list(T.shape), float(sigma),
                        ks.tolist(), list(looks), alpha, seed, RESULTS_VERSION])
     key = hashlib.sha256(blob.encode()).hexdigest()[:16]
@@ -329,8 +533,20 @@ def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma
     except (OSError, ValueError, KeyError, TypeError):
         pass
     started = time.perf_counter()
-    out = monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
-    seconds = time.perf_counter() - started  # benchmarks/bench_book.py reads it
+    jobs = int(min(jobs, ks.size))
+    if jobs == 1:
+        out = monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
+    else:
+        from joblib import Parallel, delayed
+
+        parts = Parallel(n_jobs=jobs)(delayed(_one_thread_changes)(env, T, sigma, ks[j::jobs], looks, alpha, seed)
+                                      for j in range(jobs))
+        joined = MonteCarloOutcomes.join(parts)
+        order = np.argsort(np.concatenate([np.arange(ks.size)[j::jobs] for j in range(jobs)]), kind="stable")
+        out = MonteCarloOutcomes(*(getattr(joined, f)[order] for f in ("updates", "change", "lower", "upper",
+                                                                        "rollouts", "outcome")),
+                                 looks=joined.looks, alpha=joined.alpha, steps=joined.steps)
+    seconds = time.perf_counter() - started  # benchmarks/bench_book.py and safepg.thesis.budget read it
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{key}~", suffix=".tmp")
     with os.fdopen(fd, "w") as f:
@@ -339,9 +555,19 @@ def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma
     return out
 
 
-def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, per_run: int, folder: Path,
-                 looks: tuple[int, ...] = MC_LOOKS, alpha: str = MC_ALPHA, seed: int = 0) -> MonteCarloOutcomes:
-    """:func:`cached_monte_carlo_changes` on ``per_run`` updates spread over each run, joined.
+def _one_thread_changes(*args: Any) -> MonteCarloOutcomes:
+    """:func:`monte_carlo_changes` in a joblib process, its kernels on one thread (the processes
+    share the cores; a batch does not depend on the thread count, ``safepg.streams``)."""
+    import numba
+
+    numba.set_num_threads(1)
+    return monte_carlo_changes(*args)
+
+
+def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, folder: Path,
+                 looks: tuple[int, ...] = MC_LOOKS, alpha: str = MC_ALPHA, seed: int = 0,
+                 jobs: int = 1) -> list[MonteCarloOutcomes]:
+    """:func:`cached_monte_carlo_changes` on every update of each run that moved theta, run by run.
 
     Parameters
     ----------
@@ -352,18 +578,20 @@ def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, per_run: in
         theta column).
     sigma : float
         The policies' standard deviation.
-    per_run : int
-        Updates measured per run (:func:`spread_updates`: the first, the last and evenly between).
     folder : Path
-        Where the measurements are stored.
+        Where the measurements are stored (one file per run).
+    looks, alpha, seed
+        As in :func:`monte_carlo_changes`: the last look sets the detection floor of the updates
+        that stay undetermined.
+    jobs : int
+        Processes per run (:func:`cached_monte_carlo_changes`; the outcomes do not depend on it).
 
     Returns
     -------
-    MonteCarloOutcomes
-        All runs' measured updates in one (``updates`` keeps each run's own indices).
+    list of MonteCarloOutcomes
+        One per run, every update k with theta[k + 1] != theta[k] (:func:`moved_updates`), in
+        order; :meth:`MonteCarloOutcomes.counts` summarises a run, :meth:`MonteCarloOutcomes.join`
+        pools several.
     """
-    parts = [cached_monte_carlo_changes(folder, env, T, sigma, spread_updates(len(T) - 1, per_run), looks, alpha,
-                                        seed) for T in runs]
-    return MonteCarloOutcomes(*(np.concatenate([getattr(p, f) for p in parts])
-                                for f in ("updates", "change", "lower", "upper", "rollouts", "outcome")),
-                              looks=tuple(looks), alpha=alpha, steps=sum(p.steps for p in parts))
+    return [cached_monte_carlo_changes(folder, env, T, sigma, moved_updates(T), looks, alpha, seed, jobs)
+            for T in runs]
