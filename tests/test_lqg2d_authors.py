@@ -145,13 +145,13 @@ def _authors_run(batch: list[int], J: list[float]) -> AuthorsRun:
                                         "J": np.array(J), "J_hat": np.zeros(len(batch))}, {})
 
 
-def test_seed_band_of_the_2d_overlays_is_the_95_percent_t_interval() -> None:
+def test_seed_band_of_the_2d_overlays_is_the_95_percent_prediction_band_for_one_run() -> None:
     v = np.array([[1.0, 2.0, np.nan], [3.0, 2.0, 5.0], [5.0, 2.0, np.nan]])
     mean, lo, hi = overlays.seed_band95(v)
     np.testing.assert_allclose(mean, [3.0, 2.0, 5.0])
-    half = t_quantile_975(2) * 2.0 / math.sqrt(3)
+    half = t_quantile_975(2) * 2.0 * math.sqrt(1 + 1 / 3)
     np.testing.assert_allclose([lo[0], hi[0]], [3 - half, 3 + half])
-    assert lo[1] == hi[1] == 2.0 and lo[2] == hi[2] == 5.0  # no spread; one seed left
+    assert lo[1] == hi[1] == 2.0 and np.isnan(lo[2]) and np.isnan(hi[2])  # no spread; one seed left: no band
 
 
 def test_figure_5_8_overlay_draws_our_mean_and_their_J_divided_by_16() -> None:

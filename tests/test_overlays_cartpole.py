@@ -26,13 +26,13 @@ RECORDS = {"adaptive": [_record([1000, 3000, 4000], [187.0, 188.0, 190.0]),
            "N=4000": [_record([4000, 4000], [187.0, 194.0]), _record([4000, 4000], [188.0, 180.0])]}
 
 
-def test_curves_are_the_seed_mean_and_its_t_band():
+def test_curves_are_the_seed_mean_and_its_prediction_band():
     grid = np.array([1, 1000, 1001, 3500, 7999])
     c = overlays.cartpole_overlay_curves(RECORDS, grid)
     # Trajectory 3500: batch 2 of seed 0 (1001-4000), batch 3 of seed 1 (3001-8000), batch 2 of seed 2 (1001-7000).
     at_3500 = np.array([188.0, 191.0, 187.5])
     m, s = at_3500.mean(), at_3500.std(ddof=1)
-    h = stats.t.ppf(0.975, 2) * s / np.sqrt(3)
+    h = stats.t.ppf(0.975, 2) * s * np.sqrt(1 + 1 / 3)  # the band for one run: theirs is one run
     ours = c["ours"]["adaptive"]
     assert ours["mean"][3] == pytest.approx(m) and ours["lo"][3] == pytest.approx(m - h)
     assert ours["hi"][3] == pytest.approx(m + h)
@@ -50,7 +50,7 @@ def test_figure_draws_those_curves():
     lines = {line.get_label(): line for line in ax.get_lines()}
     grid = np.unique(np.linspace(1, 8000, 50).astype(np.int64))
     c = overlays.cartpole_overlay_curves(RECORDS, grid)
-    ours = lines["ours: adaptive (3 seeds, 95% band)"]
+    ours = lines["ours: adaptive (3 seeds, 95% band for one run)"]
     assert np.allclose(ours.get_ydata(), c["ours"]["adaptive"]["mean"], equal_nan=True)
     theirs = lines["authors' run: fixed step"]
     assert np.array_equal(theirs.get_ydata()[1:], cartpole_runs()["fixed"]["J_hat"])

@@ -12,7 +12,7 @@ import pytest
 
 from safepg.envs.lqg import LQG
 from safepg.learning import vanilla_pg
-from safepg.stats import mean_ci95
+from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis import overlays as O
 from safepg.thesis.analysis import performance_on_grid
@@ -30,17 +30,18 @@ def short_runs():
     return out
 
 
-def test_seed_band_is_mean_ci95_column_by_column():
+def test_seed_band_is_the_prediction_interval_column_by_column():
     rng = np.random.default_rng(3)
     v = rng.normal(size=(5, 7))
     v[4, 6] = np.nan  # a run that ended earlier
-    mean, lo, hi = O.seed_band95(v)
-    for j in range(7):
-        ref = mean_ci95(v[~np.isnan(v[:, j]), j])
-        assert mean[j] == pytest.approx(ref["mean"], rel=1e-12)
-        assert [lo[j], hi[j]] == pytest.approx(ref["ci95"], rel=1e-12)
+    for runs in (1, 5):  # one run of theirs, or their five-run mean (Figures 5.1-5.2)
+        mean, lo, hi = O.seed_band95(v, runs=runs)
+        for j in range(7):
+            ref = prediction_interval95(v[~np.isnan(v[:, j]), j], runs=runs)
+            assert mean[j] == pytest.approx(ref["mean"], rel=1e-12)
+            assert [lo[j], hi[j]] == pytest.approx(ref["pi95"], rel=1e-12)
     m1, lo1, hi1 = O.seed_band95(v[:1])
-    assert np.array_equal(m1, lo1) and np.array_equal(m1, hi1)  # one seed: no band
+    assert np.array_equal(m1, v[0]) and np.all(np.isnan(lo1)) and np.all(np.isnan(hi1))  # one seed: no band
 
 
 @pytest.mark.parametrize("quantity", ["J", "theta"])
@@ -57,10 +58,10 @@ def test_table51_overlay_draws_our_runs_and_the_authors_run(short_runs, quantity
             per_seed = np.array([r.J if quantity == "J" else r.theta[:, 0] for r in recs])
             assert np.array_equal(ours_line.get_xdata(), n * np.arange(6))
             assert np.allclose(ours_line.get_ydata(), per_seed.mean(axis=0), rtol=0, atol=1e-13)
-            # The band is mean_ci95 of the seeds at each point.
+            # The band is the prediction interval for one run (theirs is one run) at each point.
             band = ax.collections[0].get_paths()[0].vertices[:, 1]
             for k in range(per_seed.shape[1]):
-                for end in mean_ci95(per_seed[:, k])["ci95"]:
+                for end in prediction_interval95(per_seed[:, k])["pi95"]:
                     assert np.min(np.abs(band - end)) < 1e-12
             # Theirs: every row of their file, theta as written, J at standard deviation sigma.
             assert np.array_equal(theirs_line.get_xdata(), n * np.arange(run.iterations))

@@ -226,7 +226,8 @@ def _lqg1d_scores(recs: Mapping[str, Sequence[LearningRecord]]) -> list[CurveSco
         where = "Figures 5.1 and 5.2" if both else f"Figure {figure}"
         s = overlays.figure51_52_overlay_series(recs, cfg)
         scores.append(_score(figure, cfg.name, "J(θ) of the policy in use (closed form), every 1000 trajectories",
-                             where, _source(curves[key]), exp.name, 5, "trajectories", s["x"], s["authors"],
+                             where, _source(curves[key]), exp.name, overlays.FIGURES_51_52_RUNS, "trajectories",
+                             s["x"], s["authors"],
                              s["values"], rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS)))
         if not (cfg.estimator == "gpomdp" and cfg.delta == 0.95):
             continue

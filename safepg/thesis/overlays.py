@@ -1,6 +1,7 @@
 """Our runs drawn over the authors' raw outputs (``safepg.thesis.authors``): one function per figure.
 
-Each function draws our curve (mean and 95% band over seeds) over the authors' own run(s)
+Each function draws our curve (mean over seeds and the 95% prediction band for a curve of the kind
+they plotted, :func:`seed_band95`) over the authors' own run(s)
 of the same setting, from the stored records and the data files, and returns the figure.
 """
 
@@ -18,7 +19,7 @@ from matplotlib.figure import Figure
 
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
-from safepg.stats import t_quantile_975
+from safepg.stats import prediction_band95
 from safepg.thesis import authors, plotting
 from safepg.thesis.analysis import measured_on_grid, performance_on_grid
 from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, cartpole_runs, lqg2d_runs
@@ -29,28 +30,33 @@ from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, car
 T51_OVERLAY_CELLS = ((0.5, 1000, 1e-3), (0.5, 1000, 1e-4), (1.0, 1000, 1e-3), (1.0, 1000, 1e-4))
 
 
-def seed_band95(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mean over seeds (axis 0) and the 95% Student-t band, point by point.
+#: Runs behind each of the authors' curves of Figures 5.1-5.2 (their plotted five-run means, MANIFEST.json).
+FIGURES_51_52_RUNS = 5
 
-    The same interval as :func:`safepg.stats.mean_ci95`, for every column at once; a single
-    seed gives a band of zero width. NaN entries (a run that ended earlier) are left out.
+
+def seed_band95(values: np.ndarray, runs: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Mean over seeds (axis 0) and the 95% prediction band for a curve of ``runs`` runs, point by point.
+
+    .. math:: \bar x \pm t_{0.975,\,k-1}\, s \sqrt{1/n + 1/k}
+
+    over the :math:`k` seeds present at each point, :math:`n` = ``runs``
+    (:func:`safepg.stats.prediction_band95`): the band that holds, with probability 0.95 at each
+    point, one new run (``runs=1``) or the mean of ``runs`` new runs. It is drawn for the kind of
+    curve the authors plotted beside it (a single run, or their 5-run mean of Figures 5.1-5.2), and it
+    is the band the scorecard holds their curve against (:mod:`safepg.thesis.curve_bands`). NaN
+    entries (a run that ended earlier) are left out; a point with fewer than two seeds has no band (NaN).
 
     Parameters
     ----------
     values : ndarray, shape (seeds, points)
+    runs : int
+        How many runs the predicted curve averages.
 
     Returns
     -------
     mean, lo, hi : ndarray, shape (points,)
     """
-    v = np.asarray(values, dtype=float)
-    n = np.sum(~np.isnan(v), axis=0)
-    with warnings.catch_warnings():  # columns with no seed, or one: NaN mean, no band
-        warnings.simplefilter("ignore", RuntimeWarning)
-        mean = np.nanmean(v, axis=0)
-        sd = np.where(n > 1, np.nanstd(v, axis=0, ddof=1), 0.0)
-    t = np.array([t_quantile_975(int(k) - 1) if k > 1 else 0.0 for k in n])
-    half = t * sd / np.sqrt(np.maximum(n, 1))
+    mean, half, _ = prediction_band95(values, runs)
     return mean, mean - half, mean + half
 
 
@@ -60,7 +66,8 @@ def _t51_name(sigma: float, n: int, alpha: float) -> str:
 
 def table51_overlay_series(records: Mapping[str, Sequence[LearningRecord]], cell: tuple[float, int, float],
                            quantity: Literal["J", "theta"] = "J") -> dict[str, np.ndarray]:
-    """The curves of one Table 5.1 cell: ours (seed mean and 95% band) and the authors' run.
+    """The curves of one Table 5.1 cell: ours (seed mean and 95% prediction band for one run) and the
+    authors' run.
 
     Both are read at the batch starts, trajectory k N for k = 0, 1, ... The authors' J column
     reads sigma as a variance (their sigma = 0.5 files start at -7.134), so their J is
@@ -99,7 +106,8 @@ def table51_overlay_series(records: Mapping[str, Sequence[LearningRecord]], cell
 def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
                            cells: Sequence[tuple[float, int, float]] = T51_OVERLAY_CELLS,
                            quantity: Literal["J", "theta"] = "J", label: str = "ours") -> Figure:
-    """Table 5.1's fixed-step runs: ours (mean and 95% band over seeds) over the authors' run.
+    """Table 5.1's fixed-step runs: ours (mean and 95% prediction band for one run) over the authors'
+    run.
 
     One panel per cell (sigma, N, alpha), two columns; J (or theta) against the trajectories
     at each batch start. The dotted line is the optimum of the closed form.
@@ -137,13 +145,14 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
 
 
 def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config) -> dict[str, np.ndarray]:
-    """One curve of Figures 5.1-5.2: ours (seed mean and 95% band of the closed-form J of the
+    """One curve of Figures 5.1-5.2: ours (seed mean and 95% prediction band for a five-run mean of the
+    closed-form J of the
     policy that generated trajectory T; ``values``, each seed's) and the authors' five-run mean,
     on their grid of T."""
     curve = authors.figure51_52_curves()[(config.estimator, config.bound, config.empirical_range, config.delta)]
     grid = curve["trajectories"].astype(np.int64)
     values = performance_on_grid(records[config.name], grid)
-    mean, lo, hi = seed_band95(values)
+    mean, lo, hi = seed_band95(values, runs=FIGURES_51_52_RUNS)
     return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"], "values": values}
 
 
@@ -162,7 +171,8 @@ def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningReco
 
 def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
                        ylim: tuple[float, float] | None = None) -> Figure:
-    """Figure 5.1 (Chebyshev, each delta): our ``table-5.2`` runs (mean and 95% band over
+    """Figure 5.1 (Chebyshev, each delta): our ``table-5.2`` runs (mean and 95% prediction band for a
+    five-run mean over
     seeds, in colour) under the authors' five-run means (black, dashed); one panel per estimator."""
     estimators = [e for e in ("gpomdp", "reinforce") if any(c.estimator == e for c in configs)]
     fig, axes = plt.subplots(1, len(estimators), figsize=(7, 3.6), squeeze=False, sharey=True)
@@ -181,7 +191,7 @@ def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs:
 def figure_5_2_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
                        ylim: tuple[float, float] | None = None) -> Figure:
     """Figure 5.2 (G(PO)MDP, delta = 0.95, each bound): our ``table-5.2`` runs (mean and 95%
-    band over seeds, in colour) under the authors' five-run means (black, dashed)."""
+    prediction band for a five-run mean, in colour) under the authors' five-run means (black, dashed)."""
     fig, ax = plt.subplots(figsize=(7, 3.8))
     _figure51_52_panel(ax, records, configs,
                        {c.name: plotting.bound_color(c.bound, c.empirical_range) for c in configs},
@@ -409,8 +419,8 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     Returns
     -------
     dict
-        ``ours[name]``: ``mean``, ``lo``, ``hi`` (the seed mean of the batch-average return and its
-        95% Student-t band, :math:`\bar x \pm t_{0.975,n-1} s/\sqrt n`), ``seeds`` and ``values``
+        ``ours[name]``: ``mean``, ``lo``, ``hi`` (the seed mean of the batch-average return and the
+        95% prediction band for one run, :math:`\bar x \pm t_{0.975,n-1} s \sqrt{1 + 1/n}`), ``seeds`` and ``values``
         (each seed's curve, (seeds, len(grid)));
         ``authors[name]``: ``trajectories`` (each batch's last trajectory) and ``J_hat``, from
         :func:`safepg.thesis.authors.cartpole_runs` (``"adaptive"`` and ``"N=4000"``, their fixed run).
@@ -431,7 +441,8 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
 
 def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], labels: Mapping[str, str],
                             budget: int = TABLE_5_4_BUDGET, points: int = 800) -> Figure:
-    """Figure 5.9 under the authors' settings: our runs (seed mean, 95% band) over the authors' two runs.
+    """Figure 5.9 under the authors' settings: our runs (seed mean, 95% prediction band for one run) over
+    the authors' two runs.
 
     ``labels`` maps our config names (``"adaptive"``, ``"N=4000"``) to legend labels. The authors'
     runs (thin, dark) are their output files' batch means, each held over its batch; the x-axis
@@ -443,7 +454,7 @@ def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], lab
     for name, label in labels.items():
         col = _CARTPOLE_COLORS.get(name, "#3b6fb6")
         c = curves["ours"][name]
-        ax.plot(grid, c["mean"], color=col, label=f"ours: {label} ({c['seeds']} seeds, 95% band)")
+        ax.plot(grid, c["mean"], color=col, label=f"ours: {label} ({c['seeds']} seeds, 95% band for one run)")
         ax.fill_between(grid, c["lo"], c["hi"], color=col, alpha=0.25, linewidth=0)
         a = curves["authors"][name]
         # Each batch's mean held over the batch's trajectories (a step that ends at the batch's end).
