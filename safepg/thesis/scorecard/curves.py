@@ -82,16 +82,16 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
             authors = {"authors": theirs["text"], "authors_value": theirs["share"], "authors_ok": theirs["holds"],
                        "authors_seeds": theirs["seeds"], "authors_experiment": theirs["worst"].experiment,
                        "authors_interval_text": theirs["band"], "authors_note": AUTHORS_NOTES.get(figure, "")}
-        failing = [c for c in (ours, theirs) if c is not None and not c["holds"]]
-        who = {id(ours): "Ours", id(theirs): "Under the authors' settings, ours"}
-        remark = " ".join(f"{who[id(c)]}: their curve {outside_sentence(c['worst'])}" for c in failing)
+        remark = " ".join(f"{label}: their curve {outside_sentence(c['worst'])}"
+                          for label, c in (("Ours", ours), ("Under the authors' settings, ours", theirs))
+                          if c is not None and not c["holds"])
+        runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
         b.add(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
               where=first.where, thesis=f"the authors' curve ({first.kind})",
               ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],
               rule="curve-band", kind="whole curve", page=page, heading=heading,
               ours_value=None if ours is None else ours["share"],
               seeds=None if ours is None else ours["seeds"], interval_text="" if ours is None else ours["band"],
-              authors_output=f"{len(sides.get('ours', sides.get('authors', [])))} run(s) of theirs"
-              if "/run-" in first.curve else "their curve", authors_output_source=first.source,
+              authors_output=f"their {runs} runs" if runs > 1 else "their curve", authors_output_source=first.source,
               fields={"figure": figure, "curve": curve, "experiment": None if ours is None else first.experiment},
               remark=remark, **authors)

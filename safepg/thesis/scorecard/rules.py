@@ -158,7 +158,7 @@ class Note:
 #: The authors' curves of Figures 5.1 and 5.2 that leave our band.
 _FIGURES_5_1_5_2 = Note(
     "Open: the authors' five-run mean leaves our band for a five-run mean, which is narrow (about ±0.07 at "
-    "J ≈ -54), over the ranges below; where Table 5.2's Ῡ of the same runs agrees with the print (every row but "
+    "J ≈ -54), over the ranges listed next; where Table 5.2's Ῡ of the same runs agrees with the print (every row but "
     "the two theoretical-range ones), the gap is in the course of J, not in its average. What is missing: their "
     "runs' own J curves (only their mean is committed), to tell one run's lead or lag from a difference of the "
     "method.", "lqg1d", "Figures 5.1 and 5.2", explains=False)
