@@ -17,7 +17,7 @@ points there with fewer than two seeds have no band and are counted apart.
 
 The curves are the overlays' own (their series functions), against the experiment each figure
 draws: ``table-5.2`` (Figures 5.1-5.4), ``figures-5.5-5.6``, ``table-5.3`` and
-``table-5.3-authors`` (Figures 5.7-5.8), ``table-5.4-authors-theta-star`` (Figure 5.9).
+``table-5.3-authors`` (Figures 5.7-5.8), ``table-5.4`` and ``table-5.4-authors-theta-star`` (Figure 5.9).
 A curve drawn in two figures (Chebyshev, G(PO)MDP, delta = 0.95, in 5.1 and 5.2, and in 5.3
 and 5.4) is scored once, under the first.
 """
