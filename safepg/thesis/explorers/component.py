@@ -78,6 +78,23 @@ class Select:
 
 
 @dataclass(frozen=True)
+class Checkbox:
+    """An on/off switch; the page passes ``true``/``false`` (``p[name]`` is a bool).
+
+    ``options`` lets a view that knows only sliders and selects (the kernel view) offer it
+    as a yes/no choice with the same bool values.
+    """
+
+    name: str
+    label: str
+    value: bool = False
+
+    @property
+    def options(self) -> tuple[tuple[bool, str], ...]:
+        return ((True, "yes"), (False, "no"))
+
+
+@dataclass(frozen=True)
 class Plot:
     """One SVG plot of the explorer."""
 
@@ -105,7 +122,7 @@ class Explorer:
     """
 
     title: str
-    controls: list[Slider | Select]
+    controls: list[Slider | Select | Checkbox]
     plots: list[Plot]
     compute_js: str
     compute_py: Callable[[dict[str, Any]], dict[str, Any]]
@@ -123,7 +140,11 @@ class Explorer:
         style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
         rows = []
         for c in self.controls:
-            if isinstance(c, Slider):
+            if isinstance(c, Checkbox):  # the <label> wraps the box: clicking the words toggles it
+                rows.append(f'<label {style}><input type="checkbox" data-param="{c.name}"'
+                            f'{" checked" if c.value else ""} style="vertical-align:middle"> '
+                            f"{html.escape(c.label)}</label>")
+            elif isinstance(c, Slider):
                 rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
                             f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
                             f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')

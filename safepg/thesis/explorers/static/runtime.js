@@ -110,12 +110,17 @@ function safepgPlot(svg, spec, res) {
     if (mk.label) el("text", {x: X(mk.x) + 7, y: Y(mk.y) - 7, "font-size": 11, ...ink}, mk.label);
   }
 }
+function safepgParam(inp) {
+  // A control's value: a checkbox's checked state (true/false), a select's string, a slider's number.
+  if (inp.type === "checkbox") return inp.checked;
+  return inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value);
+}
 function safepgExplorer(root, spec, compute, lib) {
   const inputs = root.querySelectorAll("[data-param]");
   const valuesEl = root.querySelector(".safepg-values");
   function params() {
     const p = {};
-    inputs.forEach(inp => { p[inp.dataset.param] = inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value); });
+    inputs.forEach(inp => { p[inp.dataset.param] = safepgParam(inp); });
     return p;
   }
   function update() {
