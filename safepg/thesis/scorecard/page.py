@@ -37,28 +37,32 @@ def _status_html(status: str) -> str:
     return f'<span class="sc-status {_STATUS_CLASS[status]}">{html.escape(status)}</span>'
 
 
-def _wrap(table: str, css: bool, label: str) -> str:
+def _wrap(table: str, css: bool, label: str, hint: bool = True) -> str:
     box = (f'<div class="sc-scroll" tabindex="0" role="region" aria-label="{html.escape(label)} (scrolls sideways)">'
            f"{table}</div>")
-    return f'{_style_sheet() if css else ""}<div class="sc-out">{_HINT}{box}</div>'
+    return f'{_style_sheet() if css else ""}<div class="sc-out">{_HINT if hint else ""}{box}</div>'
 
 
 def summary_html(rows: Sequence[Row], css: bool = True) -> str:
-    """The counts per group and status, each group linked to its section of the page.
+    """The counts per status (rows) and part of the thesis (columns), each part linked to its
+    section of the page.
 
+    One column per part keeps the table narrow enough for a laptop's page width: the statuses'
+    long names sit in the first column, where they wrap, instead of in a header row.
     ``css``: include the style sheet of the scorecard tables (once per page is enough).
     """
     c = counts(rows)
     flagged = {g: sum(bool(r.no_information) for r in rows if g in ("all", r.group)) for g in c}
-    head = "<tr><th>part of the thesis</th>" + "".join(f"<th>{_status_html(s)}</th>" for s in STATUSES) + \
-        "<th>rows</th><th>of which one of ours agrees without information</th></tr>"
-    body = []
-    for g, n in c.items():
-        name = "<strong>all</strong>" if g == "all" else f'<a href="#{heading_id(g)}">{html.escape(g)}</a>'
-        body.append(f"<tr><td>{name}</td>" + "".join(f'<td class="sc-num">{n[s]}</td>' for s in STATUSES)
-                    + f'<td class="sc-num">{sum(n.values())}</td><td class="sc-num">{flagged[g]}</td></tr>')
-    table = f'<table class="sc-table sc-summary"><thead>{head}</thead><tbody>{"".join(body)}</tbody></table>'
-    return _wrap(table, css, "rows per status")
+    head = "<tr><th>status</th>" + "".join(
+        "<th><strong>all</strong></th>" if g == "all" else f'<th><a href="#{heading_id(g)}">{html.escape(g)}</a></th>'
+        for g in c) + "</tr>"
+    lines = [(_status_html(s), [n[s] for n in c.values()]) for s in STATUSES]
+    lines.append(("rows", [sum(n.values()) for n in c.values()]))
+    lines.append(("of which one of ours agrees without information", list(flagged.values())))
+    body = "".join(f"<tr><th scope=\"row\">{label}</th>" + "".join(f'<td class="sc-num">{v}</td>' for v in values)
+                   + "</tr>" for label, values in lines)
+    table = f'<table class="sc-table sc-summary"><thead>{head}</thead><tbody>{body}</tbody></table>'
+    return _wrap(table, css, "rows per status", hint=False)
 
 
 def _split(text: str) -> str:
