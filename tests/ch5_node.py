@@ -1,0 +1,34 @@
+"""Run the Chapter 5 explorers' page objects (static/ch5_page.js + lqg2d_page.js or cartpole_page.js)
+under Node: their ``configs`` and ``result`` on given settings and traces, to hold them against their
+Python twins in tests/test_lqg2d_learner.py and tests/test_cartpole_learner.py."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from typing import Any
+
+from safepg.thesis.explorers.component import static_text
+
+NODE = shutil.which("node")
+_SCRIPT = r"""
+const src = require("fs").readFileSync(0, "utf8");
+const req = JSON.parse(src);
+const page = new Function(req.src + "\nreturn " + req.object + ";")();
+const out = req.cases.map(c => ({
+  configs: c.configs ? page.configs(c.p, c.data) : null,
+  result: c.traces ? page.result(c.p, {runs: c.traces}, c.data) : null,
+  linked: c.linked ? page.linked(c.linked[0], c.linked[1]) : null}));
+process.stdout.write(JSON.stringify(out));
+"""
+
+
+def run_page(script: str, obj: str, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces", "linked"}``."""
+    src = static_text("ch5_page.js") + "\n" + static_text(script)
+    proc = subprocess.run([NODE, "-e", _SCRIPT], input=json.dumps({"src": src, "object": obj, "cases": cases}),
+                          capture_output=True, text=True, timeout=120, check=False)
+    if proc.returncode:
+        raise RuntimeError(proc.stderr)
+    return json.loads(proc.stdout)
