@@ -41,6 +41,7 @@ from safepg.learning import adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.live_learner import (
+    learner_js,
     live_batch_size_explorer,
     run_summary,
     still_tolerance,
@@ -49,9 +50,11 @@ from safepg.thesis.explorers.live_learner import (
 )
 
 NODE = shutil.which("node")
-# Node requires it by path: the file as the package ships it.
-LEARNER = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
-PAGE = LEARNER.with_name("live_page.js")
+# Node requires it by path: the learner as the page loads it, its files concatenated.
+STATIC = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
+PAGE = STATIC.with_name("live_page.js")
+LEARNER = Path(tempfile.mkdtemp()) / "learner_all.js"
+LEARNER.write_text(learner_js())
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
 RTOL = 1e-12
 
@@ -167,6 +170,36 @@ def random_samples(rng: np.random.Generator) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------ deterministic parts
+#: Fixed-seed 1-D runs of the learner before it was split into files and widened to vector tasks
+#: (the learner.js of commit 910a88b): the SHA-256 of JSON.stringify(record), iterations, final theta.
+ONE_D_BEFORE = [
+    ({"algorithm": "adaptive", "seed": 7, "budget": 200000, "bound": "bernstein", "empiricalRange": True},
+     "056c404e49f0d169814f517b269ce49a7224baee9e4258a4d7645916df1b1a90", 841, -0.14685914910472053),
+    ({"algorithm": "adaptive", "seed": 3, "budget": 100000, "bound": "chebyshev", "estimator": "reinforce",
+      "theta0": -0.3}, "012be13142b11071f9a2f08ff13cd8b9185957f38a0e392004c7881c3f619012", 3, -0.3000689103392606),
+    ({"algorithm": "vanilla", "seed": 5, "stream": 1, "budget": 30000, "batchSize": 100, "alpha": 1e-3, "score": "raw"},
+     "48d9f36caaed51c7bf2260ed127bc0687f457fb47d754d8463b8b496ed3adbb6", 300, -0.6006164702129522),
+]
+
+
+def test_one_d_runs_are_what_they_were():
+    """The 1-D explorer gives the same record for the same seed as before the vector tasks, through
+    Run and through the Driver with the 1-D task of safepgLearner.lqgTask."""
+    script = (f"const L = require({json.dumps(str(LEARNER))}); const h = require('crypto');"
+              "const cfgs = JSON.parse(process.argv[1]); const out = cfgs.map(c => {"
+              "  const r = new L.Run(c).finish(), s = JSON.stringify(r.rec);"
+              "  const d = new L.Driver({task: L.lqgTask({dim: 1}), runs: [{name: 'x', cfg: c}]});"
+              "  const th = []; while (!d.done) for (const p of d.advance(100)) th.push(...p.theta);"
+              "  return [h.createHash('sha256').update(s).digest('hex'), r.rec.batchSize.length,"
+              "          r.rec.theta[r.rec.theta.length - 1],"
+              "          JSON.stringify(th) === JSON.stringify(r.rec.theta.slice(1))];"
+              "}); console.log(JSON.stringify(out));")
+    proc = subprocess.run([NODE, "-e", script, json.dumps([c for c, *_ in ONE_D_BEFORE])], capture_output=True,
+                          text=True, check=True)
+    for (_, sha, iterations, theta), got in zip(ONE_D_BEFORE, json.loads(proc.stdout)):
+        assert got == [sha, iterations, theta, True]
+
+
 def test_bounds_step_and_batch_size_match_safepg():
     rng = np.random.default_rng(12)
     env = LQG.thesis_1d()

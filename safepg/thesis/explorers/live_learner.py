@@ -67,8 +67,11 @@ TITLE = "Algorithm 4.1 live: adaptive batch size on the 1-D LQG, computed in you
 
 
 def learner_js() -> str:
-    """The JavaScript learner shipped in the package (``safepg/thesis/explorers/static/learner.js``)."""
-    return static_text("learner.js")
+    """The JavaScript learner shipped in the package: ``static/learner.js`` and the files that extend
+    it to the vector tasks, concatenated (:func:`safepg.thesis.explorers.js_tasks.learner_sources`)."""
+    from safepg.thesis.explorers.js_tasks import learner_sources
+
+    return learner_sources()
 
 
 def _round(values: Any, digits: int = DIGITS) -> list[float | None]:

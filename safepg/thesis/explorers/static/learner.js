@@ -23,7 +23,9 @@
  * number: the adaptive and the vanilla run use streams 0 and 1) fixes every number.
  * These are not numpy's streams: the same seed gives other batches than safepg does.
  *
- * Loaded as a script it defines `safepgLearner`; under Node, `require` returns it.
+ * Loaded as a script it defines `safepgLearner`; under Node, `require` returns it. The vector
+ * tasks (the 2-D LQG, the cart-pole) come in the files concatenated after this one
+ * (live_learner.learner_js(): lqg_task.js, cartpole_task.js, vector_run.js), which add to it.
  */
 "use strict";
 const safepgLearner = (function () {
@@ -465,9 +467,11 @@ const safepgLearner = (function () {
    */
   function Driver(msg, clock) {
     this.clock = clock || (typeof performance !== "undefined" ? () => performance.now() : () => Date.now());
-    this.runs = msg.runs.map(r => ({name: r.name, run: new Run(r.cfg, msg.task), sent: 0, ms: 0}));
+    this.runs = msg.runs.map(r => ({name: r.name, run: Driver.makeRun(r.cfg, msg.task), sent: 0, ms: 0}));
     this.done = false;
   }
+  /** The run for a task: this file's 1-D Run; vector_run.js (loaded after it) widens it to every task. */
+  Driver.makeRun = (cfg, task) => new Run(cfg, task);
   Driver.prototype.advance = function (ms) {
     const t0 = this.clock();
     let now = t0;
@@ -483,7 +487,9 @@ const safepgLearner = (function () {
     return this.runs.map(r => {
       const rec = r.run.rec, i0 = r.sent, i1 = rec.batchSize.length;
       r.sent = i1;
-      return {name: r.name, from: i0, theta0: rec.theta[0], J0: rec.J[0],
+      // The 1-D run's penalty constant is fixed; a vector run records one per batch (constants="batch").
+      const c = rec.c ? rec.c.slice(i0, i1) : new Array(i1 - i0).fill(r.run.c);
+      return {name: r.name, from: i0, theta0: rec.theta[0], J0: rec.J[0], c: c,
               batchSize: rec.batchSize.slice(i0, i1), alpha: rec.alpha.slice(i0, i1),
               eps: rec.eps.slice(i0, i1), Jhat: rec.Jhat.slice(i0, i1), grad: rec.grad.slice(i0, i1),
               theta: rec.theta.slice(i0 + 1, i1 + 1), J: rec.J.slice(i0 + 1, i1 + 1),

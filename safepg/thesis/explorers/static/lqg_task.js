@@ -1,0 +1,271 @@
+/*
+ * The LQG of safepg.envs.lqg in any dimension m for the page's learner (Sections 5.1-5.2):
+ * the closed-form J(theta) and gradient of the infinite-horizon, unclipped problem, and the
+ * clipped H-step simulator with REINFORCE / G(PO)MDP gradient samples and the
+ * variance-minimising baselines per component (safepg.envs._lqg_kernel.lqg_gradient_samples).
+ *
+ * Concatenated after learner.js (it extends safepgLearner). The policy is N(K s, sigma^2 I)
+ * with K = theta as a row-major m x m gain. Sums are formed in the generic kernel's order,
+ * so that fed the same random numbers the samples agree with safepg to rounding.
+ */
+"use strict";
+(function (L) {
+  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  function asMatrix(x, m, name) {
+    if (typeof x === "number") {
+      const out = new Float64Array(m * m);
+      for (let i = 0; i < m; i++) out[i * m + i] = x;
+      return out;
+    }
+    const flat = [].concat(...x.map(r => (Array.isArray(r) ? r : [r])));
+    check(flat.length === m * m && flat.every(Number.isFinite), `${name} must be a number or an ${m} x ${m} matrix`);
+    return Float64Array.from(flat);
+  }
+  function largestDiagonal(M, m) {
+    let off = false, top = -Infinity;
+    for (let i = 0; i < m; i++) for (let j = 0; j < m; j++) {
+      if (i === j) top = Math.max(top, M[i * m + i]); else if (M[i * m + j] !== 0) off = true;
+    }
+    return off ? null : top;
+  }
+  /**
+   * A TASK for the Driver from safepg's LQG fields (camelCase): {dim, gamma, H, stateBound,
+   * actionBound, A, B, Q, R, clip}, defaults those of LQG(). The bound constants
+   * (rewardBound, featureBound, actionVolume) are derived as safepg's properties unless given
+   * (a cost matrix that is not diagonal needs its largest eigenvalue: pass rewardBound).
+   */
+  function lqgTask(settings) {
+    const s = Object.assign({dim: 1, gamma: 0.9, H: 20, stateBound: 2, actionBound: 2, A: 1, B: 1, Q: 1, R: 1,
+                             clip: true}, settings || {});
+    check(Number.isInteger(s.dim) && s.dim >= 1, `dim must be a positive integer, got ${s.dim}`);
+    check(s.gamma > 0 && s.gamma < 1, `gamma must be in (0, 1), got ${s.gamma}`);
+    check(Number.isInteger(s.H) && s.H >= 1, `H must be a positive integer, got ${s.H}`);
+    check(s.stateBound > 0 && isFinite(s.stateBound), `stateBound must be finite and > 0, got ${s.stateBound}`);
+    check(s.actionBound > 0 && isFinite(s.actionBound), `actionBound must be finite and > 0, got ${s.actionBound}`);
+    const m = s.dim, mats = {};
+    for (const k of ["A", "B", "Q", "R"]) mats[k] = Array.from(asMatrix(s[k], m, k));
+    let rb = s.rewardBound;
+    if (rb == null) {
+      const q = largestDiagonal(Float64Array.from(mats.Q), m), r = largestDiagonal(Float64Array.from(mats.R), m);
+      check(q !== null && r !== null, "rewardBound must be given for a cost matrix that is not diagonal");
+      rb = 0.5 * (q * m * (s.stateBound * s.stateBound) + r * m * (s.actionBound * s.actionBound));
+    }
+    return {kind: "lqg", dim: m, gamma: s.gamma, H: s.H, stateBound: s.stateBound, actionBound: s.actionBound,
+            A: mats.A, B: mats.B, Q: mats.Q, R: mats.R, clip: s.clip !== false, rewardBound: rb,
+            featureBound: s.featureBound != null ? s.featureBound : s.stateBound,
+            actionVolume: s.actionVolume != null ? s.actionVolume : Math.pow(2 * s.actionBound, m)};
+  }
+  /** LQG.thesis_2d(): Section 5.2.1 as printed (gamma = 0.95); the experiments run gamma = 0.9. */
+  const THESIS_2D = lqgTask({dim: 2, gamma: 0.95, H: 20});
+
+  // ----------------------------------------------------------------- linear algebra
+  function matmul(X, Y, m) {
+    const out = new Float64Array(m * m);
+    for (let i = 0; i < m; i++) for (let j = 0; j < m; j++) {
+      let acc = 0.0;
+      for (let k = 0; k < m; k++) acc += X[i * m + k] * Y[k * m + j];
+      out[i * m + j] = acc;
+    }
+    return out;
+  }
+  function transpose(X, m) {
+    const out = new Float64Array(m * m);
+    for (let i = 0; i < m; i++) for (let j = 0; j < m; j++) out[j * m + i] = X[i * m + j];
+    return out;
+  }
+  /** Solve M x = b (M n x n, row-major) by Gaussian elimination with partial pivoting. */
+  function solve(M, b, n) {
+    const a = Float64Array.from(M), x = Float64Array.from(b);
+    for (let c = 0; c < n; c++) {
+      let p = c;
+      for (let r = c + 1; r < n; r++) if (Math.abs(a[r * n + c]) > Math.abs(a[p * n + c])) p = r;
+      if (p !== c) {
+        for (let k = 0; k < n; k++) { const t = a[c * n + k]; a[c * n + k] = a[p * n + k]; a[p * n + k] = t; }
+        const t = x[c]; x[c] = x[p]; x[p] = t;
+      }
+      for (let r = c + 1; r < n; r++) {
+        const f = a[r * n + c] / a[c * n + c];
+        if (f === 0) continue;
+        for (let k = c; k < n; k++) a[r * n + k] -= f * a[c * n + k];
+        x[r] -= f * x[c];
+      }
+    }
+    for (let r = n - 1; r >= 0; r--) {
+      let acc = x[r];
+      for (let k = r + 1; k < n; k++) acc -= a[r * n + k] * x[k];
+      x[r] = acc / a[r * n + r];
+    }
+    return x;
+  }
+  /** P = M + gamma F^T P F, symmetrised (LQG._lyapunov). */
+  function lyapunov(F, M, gamma, m) {
+    const d2 = m * m, sys = new Float64Array(d2 * d2);
+    for (let i = 0; i < m; i++) for (let j = 0; j < m; j++) for (let k = 0; k < m; k++) for (let l = 0; l < m; l++) {
+      // vec(F^T P F)[i m + j] = sum_{k,l} F[k,i] F[l,j] P[k,l]
+      sys[(i * m + j) * d2 + k * m + l] = (i * m + j === k * m + l ? 1 : 0) - gamma * F[k * m + i] * F[l * m + j];
+    }
+    const P = solve(sys, M, d2), out = new Float64Array(d2);
+    for (let i = 0; i < m; i++) for (let j = 0; j < m; j++) out[i * m + j] = 0.5 * (P[i * m + j] + P[j * m + i]);
+    return out;
+  }
+  /** Whether sqrt(gamma) (A + B K) has spectral radius < 1. */
+  function stable(F, gamma, m) {
+    if (m === 1) return Math.abs(F[0]) * Math.sqrt(gamma) < 1;
+    if (m === 2) {
+      const tr = F[0] + F[3], det = F[0] * F[3] - F[1] * F[2], disc = tr * tr / 4 - det;
+      const radius = disc >= 0 ? Math.abs(tr / 2) + Math.sqrt(disc) : Math.sqrt(det);
+      return radius * Math.sqrt(gamma) < 1;
+    }
+    // Larger m: (sqrt(gamma) F)^(2^k) shrinks to 0 exactly when the radius is below 1.
+    let G = Float64Array.from(F, v => v * Math.sqrt(gamma));
+    for (let k = 0; k < 60; k++) {
+      let norm = 0;
+      for (const v of G) norm = Math.max(norm, Math.abs(v));
+      if (!(norm < 1e150)) return false;
+      if (norm < 1e-150) return true;
+      G = matmul(G, G, m);
+    }
+    return false;
+  }
+  function closedLoop(theta, task) {
+    const m = task.dim, K = Float64Array.from(theta);
+    check(K.length === m * m, `theta must have ${m * m} entries, got ${K.length}`);
+    const BK = matmul(Float64Array.from(task.B), K, m), F = new Float64Array(m * m);
+    for (let i = 0; i < m * m; i++) F[i] = task.A[i] + BK[i];
+    return {K, F};
+  }
+  function valueMatrix(K, F, task) {
+    const m = task.dim, KtR = matmul(transpose(K, m), Float64Array.from(task.R), m), KtRK = matmul(KtR, K, m);
+    const M = new Float64Array(m * m);
+    for (let i = 0; i < m * m; i++) M[i] = 0.5 * (task.Q[i] + KtRK[i]);
+    return lyapunov(F, M, task.gamma, m);
+  }
+  function trace(X, m) { let t = 0; for (let i = 0; i < m; i++) t += X[i * m + i]; return t; }
+  /** LQG.performance: J(theta) of the infinite-horizon, unclipped problem; -Infinity if unstable. */
+  function lqgPerformanceN(theta, sigma, task) {
+    const m = task.dim, {K, F} = closedLoop(theta, task);
+    if (!stable(F, task.gamma, m)) return -Infinity;
+    const P = valueMatrix(K, F, task), S = sigma * sigma, B = Float64Array.from(task.B);
+    const BtPB = matmul(matmul(transpose(B, m), P, m), B, m);
+    const noise = 0.5 * trace(task.R, m) * S + task.gamma * (trace(BtPB, m) * S);
+    return -(trace(P, m) * (task.stateBound * task.stateBound / 3)) - noise / (1 - task.gamma);
+  }
+  /** LQG.gradient: -(R K + 2 gamma B^T P F) Y with Y = W + gamma F Y F^T, flattened like theta. */
+  function lqgGradientN(theta, sigma, task) {
+    const m = task.dim, {K, F} = closedLoop(theta, task);
+    check(stable(F, task.gamma, m), "theta makes the closed loop unstable");
+    const P = valueMatrix(K, F, task), B = Float64Array.from(task.B), R = Float64Array.from(task.R);
+    const BBt = matmul(B, transpose(B, m), m), W = new Float64Array(m * m), S = sigma * sigma, g = task.gamma;
+    for (let i = 0; i < m * m; i++) W[i] = g * (BBt[i] * S) / (1 - g);
+    for (let i = 0; i < m; i++) W[i * m + i] += task.stateBound * task.stateBound / 3;
+    const Y = lyapunov(transpose(F, m), W, g, m);
+    const RK = matmul(R, K, m), BtPF = matmul(matmul(transpose(B, m), P, m), F, m), X = new Float64Array(m * m);
+    for (let i = 0; i < m * m; i++) X[i] = RK[i] + 2 * g * BtPF[i];
+    return Array.from(matmul(X, Y, m), v => -v);
+  }
+
+  // ------------------------------------------------------------------ the simulator
+  /**
+   * Workspace of the vector LQG's batches, rows of length cap (component-major, so each
+   * gradient component's samples are one contiguous row for the bounds).
+   */
+  function LqgBatch(task) {
+    this.task = task; this.m = task.dim; this.M = task.dim * task.dim; this.cap = 0;
+    this.num = new Float64Array(task.H * this.M); this.den = new Float64Array(task.H * this.M);
+    this.b = new Float64Array(task.H * this.M);
+    this.mean = new Float64Array(this.m); this.araw = new Float64Array(this.m); this.u = new Float64Array(this.m);
+    this.diff = new Float64Array(this.m); this.snext = new Float64Array(this.m);
+  }
+  LqgBatch.prototype.grow = function (n) {
+    if (n <= this.cap) return;
+    const cap = Math.max(n, Math.ceil(this.cap * 1.5)), m = this.m, M = this.M;
+    this.s = new Float64Array(m * cap); this.z = new Float64Array(m * cap); this.G = new Float64Array(M * cap);
+    this.samples = new Float64Array(M * cap); this.acc = new Float64Array(M * cap);
+    this.returns = new Float64Array(cap); this.idx = new Int32Array(cap); this.scratch = new Float64Array(cap);
+    for (let i = 0; i < cap; i++) this.idx[i] = i;
+    this.cap = cap;
+  };
+  /**
+   * n gradient samples (this.samples, component p of trajectory j at p * n + j) and discounted
+   * returns (this.returns) with gain theta. src.init(s, n, m, lo, hi) fills the initial states
+   * (s[i * n + j] uniform in [lo, hi)); src.step(z, n, m, t, idx) the step's standard normals.
+   * Returns null (LQG has no per-batch maxima).
+   */
+  LqgBatch.prototype.run = function (theta, sigma, n, opt, src) {
+    const task = this.task, m = this.m, M = this.M, H = task.H, gamma = task.gamma;
+    const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
+    const A = task.A, B = task.B, Q = task.Q, R = task.R;
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    this.grow(n);
+    const s = this.s, z = this.z, G = this.G, samples = this.samples, acc = this.acc, returns = this.returns;
+    const num = this.num, den = this.den, b = this.b;
+    const mean = this.mean, araw = this.araw, u = this.u, diff = this.diff, snext = this.snext;
+    const invVar = 1.0 / (sigma * sigma);  // the precision of sigma^2 I
+    src.init(s, n, m, -bs, bs);
+    G.fill(0, 0, M * n); samples.fill(0, 0, M * n); acc.fill(0, 0, M * n); returns.fill(0, 0, n);
+    num.fill(0); den.fill(0);
+    let disc = 1.0;
+    for (let t = 0; t < H; t++) {
+      src.step(z, n, m, t, this.idx);
+      const to = t * M;
+      for (let j = 0; j < n; j++) {
+        for (let i = 0; i < m; i++) {
+          let a = 0.0;
+          for (let k = 0; k < m; k++) a += theta[i * m + k] * s[k * n + j];
+          mean[i] = a;
+          araw[i] = a + sigma * z[i * n + j];
+          u[i] = clip ? Math.min(Math.max(araw[i], -ba), ba) : araw[i];
+        }
+        let cost = 0.0;
+        for (let i = 0; i < m; i++) {
+          const si = s[i * n + j], ui = u[i];
+          for (let k = 0; k < m; k++) cost += si * Q[i * m + k] * s[k * n + j] + ui * R[i * m + k] * u[k];
+        }
+        const dr = -0.5 * cost * disc;
+        returns[j] += dr;
+        for (let i = 0; i < m; i++) diff[i] = invVar * ((scoreClipped ? u[i] : araw[i]) - mean[i]);
+        for (let i = 0; i < m; i++) for (let k = 0; k < m; k++) {
+          const p = i * m + k, o = p * n + j;
+          const g = G[o] + diff[i] * s[k * n + j];  // the score of Section 2.3.13, summed over steps <= t
+          G[o] = g;
+          if (!reinforce) { samples[o] += g * dr; num[to + p] += g * g * dr; den[to + p] += g * g; }
+        }
+        for (let i = 0; i < m; i++) {
+          let a = 0.0;
+          for (let k = 0; k < m; k++) a += A[i * m + k] * s[k * n + j] + B[i * m + k] * u[k];
+          snext[i] = clip ? Math.min(Math.max(a, -bs), bs) : a;
+        }
+        for (let i = 0; i < m; i++) s[i * n + j] = snext[i];
+      }
+      if (!reinforce && baseline) {
+        // b_t is known once every trajectory has made step t: the baseline term of pass 2 in t order.
+        for (let p = 0; p < M; p++) {
+          const bt = den[to + p] !== 0 ? num[to + p] / den[to + p] : 0, o = p * n;
+          b[to + p] = bt;
+          for (let j = 0; j < n; j++) acc[o + j] += G[o + j] * bt;
+        }
+      }
+      disc *= gamma;
+    }
+    if (reinforce) {
+      for (let p = 0; p < M; p++) {
+        const o = p * n;
+        let nb = 0.0, db = 0.0;
+        for (let j = 0; j < n; j++) {
+          const g = G[o + j], sq = g * g;
+          nb += sq * returns[j]; db += sq;
+          samples[o + j] = g * returns[j];
+        }
+        if (baseline) {
+          const bp = db !== 0 ? nb / db : 0;
+          for (let j = 0; j < n; j++) samples[o + j] -= G[o + j] * bp;
+        }
+      }
+    } else if (baseline) {
+      for (let i = 0; i < M * n; i++) samples[i] -= acc[i];
+    }
+    return null;
+  };
+
+  Object.assign(L, {lqgTask, THESIS_2D, lqgPerformanceN, lqgGradientN, lqgSolve: solve, lqgStable: stable, LqgBatch});
+})(safepgLearner);

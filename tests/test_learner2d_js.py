@@ -1,0 +1,384 @@
+"""The page's JavaScript learner on the 2-D LQG of Section 5.2 against safepg, under Node.js.
+
+Deterministic parts (same inputs, same outputs, to 1e-12 relative): the closed-form J and
+gradient, the gradient samples and returns of a batch fed safepg's own random numbers (relative
+to the largest sample of the component: the baseline's sums are added in another order), the
+bounds and steps of every option (constants, statistics, the unguarded step, the scalar step of
+[24] and the coordinate step at a fixed N), and whole runs fed safepg's random numbers.
+
+Stochastic parts: 30 seeds each side on four settings (among them the authors' adaptive run and
+the two fixed-N steps of Figures 5.5-5.6), the difference of the means inside its 99% Welch
+interval. ``pytest -s`` prints the table; ``python tests/test_learner2d_js.py`` writes it into
+benchmarks/js_learner_agreement.md.
+
+The helpers (:func:`run_node`, :func:`welch_rows`, :func:`replay_draws`) serve
+tests/test_cartpole_js.py too.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numba
+import numpy as np
+import pytest
+from scipy import stats
+
+from safepg.bounds import error_bound
+from safepg.constants import TaskConstants
+from safepg.envs.lqg import LQG
+from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant, scalar_step
+from safepg.policies import LinearGaussianPolicy
+from safepg.streams import batch_key, trajectory_draws
+from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
+
+NODE = shutil.which("node")
+pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+RTOL = 1e-12
+ROOT = Path(__file__).resolve().parents[1]
+AGREEMENT = ROOT / "benchmarks" / "js_learner_agreement.md"
+
+HARNESS = r"""
+const L = require(process.argv[2]);
+const fs = require("fs");
+const req = JSON.parse(fs.readFileSync(0, "utf8"));
+const f64 = p => { const b = fs.readFileSync(p); return new Float64Array(b.buffer, b.byteOffset, b.length / 8); };
+const out = {};
+if (req.perf) out.perf = req.perf.map(q => ({J: L.lqgPerformanceN(q.theta, q.sigma, q.task),
+                                            grad: L.lqgGradientN(q.theta, q.sigma, q.task)}));
+if (req.steps) out.steps = req.steps.map(q => L.cartpoleStep(q.state, q.force, q.task));
+if (req.batch) out.batch = req.batch.map(q => {
+  const b = q.task.kind === "lqg" ? new L.LqgBatch(q.task) : new L.CartpoleBatch(q.task);
+  const found = b.run(Float64Array.from(q.theta), q.sigma, q.n, q.opt, L.arraySource(f64(q.U), f64(q.Z), q.H));
+  return {samples: Array.from(b.samples.subarray(0, q.n * q.m)), returns: Array.from(b.returns.subarray(0, q.n)),
+          found: found};
+});
+if (req.update) out.update = req.update.map(q => {
+  const run = new L.VectorRun(q.cfg, q.task), x = f64(q.samples), n = q.n, m = run.m;
+  run.batch.grow(n);
+  for (let p = 0; p < m; p++) { let a = 0; for (let j = 0; j < n; j++) a += x[p * n + j]; run.grad[p] = a / n; }
+  const up = q.cfg.algorithm === "vanilla" ? run.vanilla(x, n) : run.adaptive(x, n, q.found);
+  return {grad: Array.from(run.grad), step: Array.from(up.step), alpha: up.alpha, k: up.k, eps: up.eps, safe: up.safe,
+          c: up.c, next_n: up.nextN, c_bounds: run.c};
+});
+if (req.replay) {
+  const q = req.replay, run = new L.VectorRun(q.cfg, q.task, L.arraySource(f64(q.U), f64(q.Z), q.H));
+  out.replay = run.finish().rec;
+}
+if (req.seeds) out.seeds = req.seeds.map(q => {
+  const r = new L.VectorRun(q.cfg, q.task).finish(), rec = r.rec, I = rec.batchSize.length;
+  let tot = 0, w = 0;
+  for (let i = 0; i < I; i++) { tot += rec.batchSize[i]; w += rec.batchSize[i] * rec.Jhat[i]; }
+  return {iterations: I, upsilon_bar: w / tot, J_final: rec.J[I], theta_final: rec.theta[I],
+          moved: rec.theta[I].some((v, i) => v !== rec.theta[0][i])};
+});
+if (req.driver) {
+  const d = new L.Driver(req.driver), parts = [];
+  while (!d.done) parts.push(d.advance(50));
+  out.driver = parts;
+}
+process.stdout.write(JSON.stringify(out));
+"""
+
+
+def learner_file(directory: Path) -> Path:
+    """The concatenated learner (:func:`learner_sources`) as a file Node can require."""
+    path = directory / "learner_all.js"
+    path.write_text(learner_sources())
+    return path
+
+
+def run_node(request: dict[str, Any]) -> dict[str, Any]:
+    """Answer of the harness to one request (see HARNESS); large arrays travel as .bin files."""
+    with tempfile.TemporaryDirectory() as d:
+        harness = Path(d) / "harness.js"
+        harness.write_text(HARNESS)
+        proc = subprocess.run([NODE, str(harness), str(learner_file(Path(d)))], input=json.dumps(request),
+                              capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+def save(path: Path, a: np.ndarray) -> str:
+    np.ascontiguousarray(a, dtype=np.float64).tofile(path)
+    return str(path)
+
+
+def replay_draws(seed: int, sizes: Any, dim: int, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """safepg's random numbers of a run: per batch one key, trajectory i its dim uniforms then its normals."""
+    rng = np.random.default_rng(seed)
+    us, zs = [], []
+    for n in sizes:
+        u, z = trajectory_draws(batch_key(rng), int(n), dim, steps)
+        us.append(u.ravel())
+        zs.append(z.ravel())
+    return np.concatenate(us), np.concatenate(zs)
+
+
+def close_to_scale(js: np.ndarray, py: np.ndarray, rtol: float = RTOL) -> None:
+    """Each column agrees to rtol relative to its largest magnitude."""
+    scale = np.maximum(np.abs(py).max(axis=0), 1e-300)
+    assert np.all(np.abs(js - py) <= rtol * scale), np.max(np.abs(js - py) / scale)
+
+
+def welch_rows(label: str, values: dict[str, tuple[np.ndarray, np.ndarray]]) -> list[dict[str, Any]]:
+    """Per metric: the two means, their difference and its 99% half-interval (Welch)."""
+    rows = []
+    for metric, (a, b) in values.items():
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        diff = a.mean() - b.mean()
+        va, vb = a.var(ddof=1) / a.size, b.var(ddof=1) / b.size
+        se = math.sqrt(va + vb)
+        half = 0.0
+        if se > 0:
+            df = (va + vb) ** 2 / (va**2 / (a.size - 1) + vb**2 / (b.size - 1))
+            half = float(stats.t.ppf(0.995, df)) * se
+        rows.append({"setting": label, "metric": metric, "js": a.mean(), "py": b.mean(), "diff": diff,
+                     "half_ci99": half, "inside": abs(diff) <= half})
+    return rows
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    lines = ["| setting | metric | JS (30 seeds) | safepg (30 seeds) | difference | 99% CI half-width | inside |",
+             "|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['setting']} | {r['metric']} | {r['js']:.6g} | {r['py']:.6g} | {r['diff']:+.3g} | "
+              f"{r['half_ci99']:.3g} | {'yes' if r['inside'] else 'NO'} |" for r in rows]
+    return "\n".join(lines)
+
+
+def write_section(title: str, text: str) -> None:
+    """Replace (or append) the section ``## title`` of benchmarks/js_learner_agreement.md."""
+    old = AGREEMENT.read_text() if AGREEMENT.exists() else ""
+    head = f"## {title}"
+    start = old.find(head)
+    if start >= 0:
+        end = old.find("\n## ", start + len(head))
+        old = old[:start].rstrip("\n") + ("\n" + old[end:] if end >= 0 else "")
+    AGREEMENT.write_text(old.rstrip("\n") + f"\n\n{head}\n\n{text}\n")
+
+
+def one_thread(fn: Any) -> Any:
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)  # one core: the machine is shared
+    try:
+        return fn()
+    finally:
+        numba.set_num_threads(threads)
+
+
+# ------------------------------------------------------------------------ deterministic parts
+ENV = LQG.thesis_2d(gamma=0.9)  # the discount the Section 5.2 experiments run with
+TASK = lqg_task_data(ENV)
+
+
+def test_task_data_matches_the_javascript_helper():
+    got = run_node({"driver": {"task": TASK, "runs": [{"name": "a", "cfg": {"budget": 200, "nMin": 100}}]}})
+    part = {key: [v for p in got["driver"] for v in p[0][key]] for key in ("theta", "J", "c", "Jhat")}
+    assert isinstance(part["theta"][0], list) and len(part["theta"][0]) == 4
+    assert part["J"][0] is not None and len(part["c"]) == len(part["Jhat"]) == 2
+    assert got["driver"][-1][0]["done"] and len(got["driver"][0][0]["theta0"]) == 4
+    # safepgLearner.THESIS_2D is LQG.thesis_2d()
+    js = subprocess.run([NODE, "-e", f"const L=require({json.dumps(str(learner_file(Path(tempfile.mkdtemp()))))});"
+                                     "console.log(JSON.stringify([L.THESIS_2D, L.lqgTask({dim: 2, gamma: 0.9})]))"],
+                        capture_output=True, text=True, check=True)
+    thesis, ours = json.loads(js.stdout)
+    assert thesis == lqg_task_data(LQG.thesis_2d())
+    assert ours == TASK
+
+
+def test_closed_forms_match_safepg():
+    rng = np.random.default_rng(3)
+    cases, expected = [], []
+    for _ in range(60):
+        theta = rng.uniform(-0.6, 0.2, 4)
+        sigma = float(rng.uniform(0.3, 1.5))
+        if not ENV.is_stable(theta):
+            continue
+        cases.append({"theta": theta.tolist(), "sigma": sigma, "task": TASK})
+        expected.append((ENV.performance(theta, sigma), ENV.gradient(theta, sigma)))
+    got = run_node({"perf": cases})["perf"]
+    assert len(got) > 20
+    for js, (J, grad) in zip(got, expected):
+        assert abs(js["J"] - J) <= RTOL * abs(J)
+        assert np.all(np.abs(np.array(js["grad"]) - grad) <= RTOL * np.abs(grad).max())
+
+
+@pytest.mark.parametrize("estimator,baseline,score,clip", [("gpomdp", True, "clipped", True),
+                                                           ("gpomdp", False, "raw", True),
+                                                           ("reinforce", True, "clipped", True),
+                                                           ("gpomdp", True, "raw", False)])
+def test_gradient_samples_match_the_kernel(estimator, baseline, score, clip, tmp_path):
+    env = replace(ENV, clip=clip)
+    theta, sigma, n, seed = np.array([-0.3, 0.05, -0.02, -0.25]), 0.8, 1500, 11
+    policy = LinearGaussianPolicy(theta.reshape(2, 2), sigma)
+    samples, returns = env.gradient_batch(policy, n, np.random.default_rng(seed), estimator, baseline, score)
+    U, Z = replay_draws(seed, [n], 2, env.horizon * 2)
+    q = {"task": lqg_task_data(env), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": 4, "H": env.horizon,
+         "opt": {"estimator": estimator, "baseline": baseline, "score": score},
+         "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}
+    js = run_node({"batch": [q]})["batch"][0]
+    close_to_scale(np.array(js["samples"]).reshape(4, n).T, samples)
+    np.testing.assert_allclose(js["returns"], returns, rtol=RTOL)
+
+
+def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, float] | None,
+                    k_task: TaskConstants) -> dict[str, Any]:
+    """safepg.learning's rules (adaptive_pg, vanilla_pg) on samples x (n, m)."""
+    n = x.shape[0]
+    grad = x.sum(axis=0) / n
+    c_bounds = penalty_constant(k_task)
+    k = int(np.argmax(np.abs(grad)))
+    g = float(abs(grad[k]))
+    step = np.zeros_like(grad)
+    if cfg["algorithm"] == "vanilla":
+        eps = max(float(error_bound(cfg["bound"], x[:, i], cfg["delta"], k_task, "gpomdp",
+                                    cfg["empiricalRange"]).eps(n)) for i in range(grad.size))
+        a = scalar_step(grad, eps, c_bounds) if cfg["step"] == "scalar" else coordinate_step(g, eps, c_bounds)
+        if cfg["step"] == "scalar":
+            step = a * grad
+        else:
+            step[k] = a * grad[k]
+        return {"step": step, "alpha": a, "eps": eps, "safe": eps < g, "c": c_bounds, "next_n": n}
+    batch_k, c = k_task, c_bounds
+    if cfg["constants"] == "batch":
+        batch_k = replace(k_task, R=found[0], M_phi=found[1])
+        c = penalty_constant(batch_k)
+    spread = {}
+    if cfg["statistics"] == "max":
+        spread = dict(variance=float(np.var(x, axis=0, ddof=1).max()), sample_range=float(np.ptp(x, axis=0).max()))
+    eb = error_bound(cfg["bound"], x[:, k], cfg["delta"], batch_k, "gpomdp", cfg["empiricalRange"], None, **spread)
+    eps = float(eb.eps(n))
+    alpha = coordinate_step(g, eps, c, guarded=not cfg["stepWhenUnsafe"])
+    step[k] = alpha * grad[k]
+    return {"step": step, "alpha": alpha, "eps": eps, "safe": eps < g, "c": c,
+            "next_n": optimal_batch_size(g, eb, c, cfg["nMin"], cfg["nMax"])}
+
+
+def update_cases(task: dict[str, Any], k_task: TaskConstants, found_scale: float, rng: np.random.Generator,
+                 tmp_path: Path, count: int = 120) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Random samples and every option, the JavaScript request and safepg's answers."""
+    cases, expected = [], []
+    for i in range(count):
+        n = int(rng.choice([2, 7, 130, 1000, 5000]))
+        x = rng.standard_normal((n, 4)) * 10 ** rng.uniform(-1, 2, 4) + 10 ** rng.uniform(-2, 1.5, 4)
+        x *= rng.choice([-1, 1], 4)
+        algorithm = ("adaptive", "vanilla")[i % 2]
+        cfg = {"algorithm": algorithm, "bound": ("chebyshev", "hoeffding", "bernstein")[i % 3],
+               "empiricalRange": bool(rng.integers(2)) or i % 3 == 0, "delta": float(rng.uniform(0.05, 0.95)),
+               "constants": ("bounds", "batch")[(i // 2) % 2], "statistics": ("component", "max")[(i // 4) % 2],
+               "stepWhenUnsafe": bool((i // 8) % 2), "nMin": 10, "nMax": 100_000, "budget": 10**7,
+               "step": ("scalar", "coordinate")[(i // 2) % 2], "alpha": None, "batchSize": n, "estimator": "gpomdp"}
+        found = (1.0, float(found_scale * rng.uniform(0.5, 1))) if cfg["constants"] == "batch" else None
+        cases.append({"cfg": cfg, "task": task, "n": n, "found": found,
+                      "samples": save(tmp_path / f"x{i}.bin", x.T.ravel())})
+        expected.append(expected_update(cfg, x, found, k_task))
+    return cases, expected
+
+
+def check_updates(got: list[dict[str, Any]], expected: list[dict[str, Any]]) -> None:
+    moved = 0
+    for js, py in zip(got, expected):
+        assert js["safe"] == py["safe"] and js["next_n"] == py["next_n"], (js, py)
+        for key in ("alpha", "eps", "c"):
+            assert math.isclose(js[key], py[key], rel_tol=RTOL, abs_tol=0), (key, js[key], py[key])
+        np.testing.assert_allclose(js["step"], py["step"], rtol=RTOL, atol=0)
+        moved += any(js["step"])
+    assert moved > len(got) // 4
+
+
+def test_bounds_and_steps_under_every_option(tmp_path):
+    rng = np.random.default_rng(5)
+    k_task = TaskConstants.from_task(ENV, 1.0)
+    cases, expected = update_cases(TASK, k_task, ENV.state_bound, rng, tmp_path)
+    got = run_node({"update": cases})["update"]
+    check_updates(got, expected)
+    assert got[0]["c_bounds"] == pytest.approx(penalty_constant(k_task), rel=RTOL)
+
+
+@pytest.mark.parametrize("kind", ["adaptive-authors", "scalar", "coordinate"])
+def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
+    """Fed the random numbers safepg draws, the page's learner makes the same run."""
+    seed, budget = 8, 40_000
+    if kind == "adaptive-authors":
+        py = adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=budget, rng=seed,
+                         statistics="max", step_when_unsafe=True, n_max=100_000)
+        cfg = {"bound": "bernstein", "empiricalRange": True, "statistics": "max", "stepWhenUnsafe": True,
+               "nMax": 100_000}
+    else:
+        py = vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step=kind, budget=budget, rng=seed)
+        cfg = {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": kind}
+    U, Z = replay_draws(seed, py.batch_size, 2, ENV.horizon * 2)
+    js = run_node({"replay": {"cfg": {**cfg, "budget": budget}, "task": TASK, "H": ENV.horizon,
+                              "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}})["replay"]
+    assert py.iterations >= 8
+    assert js["batchSize"] == py.batch_size.tolist()
+    np.testing.assert_allclose(np.array(js["theta"]), py.theta, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(js["alpha"], py.alpha, rtol=1e-9)
+    np.testing.assert_allclose(js["Jhat"], py.J_hat, rtol=1e-12)
+    np.testing.assert_allclose(js["J"], py.J, rtol=1e-9)
+
+
+# --------------------------------------------------------------------------- stochastic parts
+SEEDS = 30
+#: name -> (safepg call, the JavaScript cfg); budgets small enough for a minute in all.
+SETTINGS: dict[str, tuple[Any, dict[str, Any]]] = {
+    "adaptive, Bernstein (e.r.), 3*10^5": (
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=300_000, rng=s),
+        {"bound": "bernstein", "empiricalRange": True, "budget": 300_000}),
+    "adaptive, authors' options, 3*10^5": (
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=300_000, rng=s,
+                              n_max=100_000, statistics="max", step_when_unsafe=True),
+        {"bound": "bernstein", "empiricalRange": True, "budget": 300_000, "nMax": 100_000, "statistics": "max",
+         "stepWhenUnsafe": True}),
+    "scalar step of [24], N = 2000, 10^5": (
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step="scalar", budget=100_000, rng=s),
+        {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "scalar", "budget": 100_000}),
+    "coordinate step, N = 2000, 10^5": (
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step="coordinate", budget=100_000,
+                             rng=s),
+        {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "coordinate", "budget": 100_000}),
+    "N = 100, alpha = 10^-6, REINFORCE, 10^5": (
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=100, alpha=1e-6, estimator="reinforce", budget=100_000,
+                             rng=s),
+        {"algorithm": "vanilla", "batchSize": 100, "alpha": 1e-6, "estimator": "reinforce", "budget": 100_000}),
+}
+
+
+def agreement(name: str, seeds: int = SEEDS) -> list[dict[str, Any]]:
+    call, cfg = SETTINGS[name]
+    js = run_node({"seeds": [{"task": TASK, "cfg": {**cfg, "seed": k}} for k in range(seeds)]})["seeds"]
+    py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
+    values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar for r in py]),
+              "final J": ([s["J_final"] for s in js], [r.J[-1] for r in py]),
+              "final theta_00": ([s["theta_final"][0] for s in js], [r.theta[-1, 0] for r in py]),
+              "iterations": ([s["iterations"] for s in js], [r.iterations for r in py])}
+    return welch_rows(f"2-D LQG: {name}", values)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(SETTINGS))
+def test_runs_agree_statistically(name):
+    rows = agreement(name)
+    print("\n" + table(rows))
+    for row in rows:
+        if row["metric"] == "iterations" and row["half_ci99"] == 0:
+            assert row["diff"] == 0
+            continue
+        assert row["inside"], row
+
+
+if __name__ == "__main__":  # the 2-D section of benchmarks/js_learner_agreement.md
+    all_rows = [r for name in SETTINGS for r in agreement(name)]
+    text = table(all_rows)
+    print(text)
+    write_section("2-D LQG (Section 5.2), gamma = 0.9", "30 seeds each side, theta_0 = 0, sigma = 1, G(PO)MDP; "
+                  "Welch 99% interval of the difference of means. Computed by `python tests/test_learner2d_js.py`."
+                  "\n\n" + text)
