@@ -43,8 +43,13 @@ book-assets:
 	bash book/tools/vendor_assets.sh
 
 # -W: warnings are errors (broken references, bad math); notebooks run through the cache.
+# First `safepg run-book` computes into results/ what the chapters compute (their experiments,
+# the Table 5.1 sweep, the safety measurements), on all cores as the notebooks do, with a
+# progress bar per experiment (plain lines, one per ~30 s, when stdout is not a terminal);
+# what is stored is one "stored" line each. The notebooks then only read results/.
 book: setup book-assets
 	bash book/tools/cache_guard.sh
+	$(VPY) -m safepg run-book
 	$(VBIN)/jupyter-book build . -W -n --keep-going
 
 bench: setup

@@ -136,6 +136,12 @@ def _experiment_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--budget", type=positive_integer)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_report)
+    p = sub.add_parser("run-book", help="compute what the book's chapters need, with progress (make book)")
+    p.add_argument("--book", help="the chapters' folder (default: book/ of this clone)")
+    p.add_argument("--root", help="the results store (default: results/ beside the book's folder)")
+    p.add_argument("--jobs", type=jobs_integer, default=-1, help="parallel workers, as the notebooks: all cores")
+    p.add_argument("--list", action="store_true", help="only list what the chapters need")
+    p.set_defaults(func=_cmd_run_book)
 
 
 def _run_command(args: argparse.Namespace) -> str:
@@ -153,6 +159,19 @@ def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
     exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
     recs = experiments.run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
     return experiments.report(exp, recs)
+
+
+def _cmd_run_book(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from safepg.thesis import prefetch
+
+    book = Path(args.book) if args.book else prefetch.BOOK
+    if args.list:
+        for t in prefetch.book_tasks(book):
+            print(f"{t.chapter:12s} {t.name}" + (f" ({t.seeds} seeds)" if t.seeds else ""))
+        return
+    prefetch.prefetch(book, Path(args.root) if args.root else None, jobs=args.jobs)
 
 
 def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:

@@ -1,0 +1,468 @@
+r"""What the book's chapters compute, computed before ``jupyter-book build``, with progress.
+
+``make book`` runs ``python -m safepg run-book`` first. It reads the chapters' code cells
+(``_toc.yml``'s notebooks, in the book's order) and finds what they compute and store:
+
+- every experiment named in a cell that calls ``run_experiment``, with the seeds the
+  experiment defines, and the experiments they warm-start from;
+- ``scorecard(..., run=True)``: the scorecard's experiments (``NEEDED``, ``RANGE_VARIANTS``);
+- ``run_sweep(...)``: the cart-pole sweep's baseline searches (``SWEEP_SEEDS`` seeds), then
+  ``cartpole-sweep``;
+- ``sweep_paths(...)``: the Table 5.1 sweep (its literal keyword arguments kept);
+- ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`).
+
+Each is computed into the store the notebooks read (``results/`` beside ``book/``, their
+``Path("..") / "results"``) by the very functions the notebooks call, with the same joblib
+parallelism (all cores), so that the notebooks then only read, and a notebook run on its own
+still computes whatever is missing. Nothing is computed twice: what is stored is loaded and
+reported as stored in one line.
+
+Progress: on a terminal, one tqdm bar per task (runs done / total, trajectories, elapsed time
+and time left), redrawn every second; otherwise (CI, a log) plain lines: one when a task
+starts, one when it ends, and at most one progress line every :data:`PLAIN_INTERVAL` seconds.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import json
+import os
+import re
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+from tqdm import tqdm
+
+from safepg import runner
+from safepg.runner import RESULTS_VERSION
+from safepg.thesis.experiments import EXPERIMENTS, experiment_folder, get_experiment, run_experiment, scaled
+
+#: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
+BOOK = Path(__file__).resolve().parents[2] / "book"
+#: Seconds between two progress lines when the output is not a terminal.
+PLAIN_INTERVAL = 30.0
+#: Seconds between two redraws of a terminal's bar (its elapsed time and time left move).
+TTY_INTERVAL = 1.0
+PREFIX = "run-book"
+
+
+@dataclass(frozen=True)
+class Task:
+    """One stored computation a chapter needs.
+
+    ``kind`` is ``"experiment"`` (``name`` in the registry, run for ``seeds`` seeds),
+    ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``) or
+    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements).
+    """
+
+    chapter: str
+    name: str
+    kind: str = "experiment"
+    seeds: int | None = None
+    options: tuple[tuple[str, Any], ...] = ()
+    #: Another trajectory budget per run (a quick look, a test); None: the experiment's own.
+    budget: int | None = None
+
+
+# ------------------------------------------------------------------ what the chapters need
+def chapters(book: Path = BOOK) -> list[Path]:
+    """The book's notebooks in ``_toc.yml``'s order (every ``book/*.ipynb`` if there is no toc)."""
+    toc = book.parent / "_toc.yml"
+    if toc.exists():
+        files = re.findall(r"^\s*-?\s*(?:file|root):\s*(\S+)\s*$", toc.read_text(), flags=re.M)
+        paths = [book.parent / f"{f}.ipynb" for f in files]
+        return [p for p in paths if p.exists()]
+    return sorted(book.glob("*.ipynb"))
+
+
+def _code_cells(notebook: Path) -> Iterator[ast.Module]:
+    for cell in json.loads(notebook.read_text())["cells"]:
+        if cell["cell_type"] != "code":
+            continue
+        src = "".join(cell["source"])
+        # IPython magics and shell escapes are not Python.
+        src = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in src.splitlines())
+        try:
+            yield ast.parse(src)
+        except SyntaxError:
+            continue
+
+
+def _called(tree: ast.AST) -> Iterator[tuple[str, ast.Call]]:
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else None
+            if name:
+                yield name, node
+
+
+def _literal_keywords(call: ast.Call, names: tuple[str, ...]) -> tuple[tuple[str, Any], ...]:
+    out = []
+    for kw in call.keywords:
+        if kw.arg in names:
+            try:
+                out.append((kw.arg, ast.literal_eval(kw.value)))
+            except ValueError:
+                continue
+    return tuple(sorted(out))
+
+
+def _experiment_names(tree: ast.AST) -> list[str]:
+    """String constants of a cell that name an experiment, in order."""
+    return [n.value for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value in EXPERIMENTS]
+
+
+def chapter_requests(notebook: Path) -> list[Task]:
+    """What one chapter's cells compute and store, in the order of its cells."""
+    from safepg.thesis.cartpole_sweep import baseline_experiments
+    from safepg.thesis.experiments import SWEEP_SEEDS
+    from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS
+
+    chapter, tasks = notebook.stem, []
+    for tree in _code_cells(notebook):
+        for name, call in _called(tree):
+            if name == "run_experiment":
+                tasks += [Task(chapter, e) for e in dict.fromkeys(_experiment_names(tree))]
+            elif name == "scorecard" and any(kw.arg == "run" and isinstance(kw.value, ast.Constant)
+                                             and kw.value.value is True for kw in call.keywords):
+                tasks += [Task(chapter, e) for e in (*NEEDED, *RANGE_VARIANTS) if e in EXPERIMENTS]
+            elif name == "run_sweep":
+                tasks += [Task(chapter, e, seeds=SWEEP_SEEDS) for e in baseline_experiments()]
+                tasks.append(Task(chapter, "cartpole-sweep"))
+            elif name == "sweep_paths":
+                tasks.append(Task(chapter, "table-5.1-sweep", "table-5.1-sweep",
+                                  options=_literal_keywords(call, ("jobs", "seeds", "budget"))))
+            elif name == "measure_runs":
+                tasks.append(Task(chapter, "safety-mc", "safety-mc"))
+    return tasks
+
+
+def book_tasks(book: Path = BOOK) -> list[Task]:
+    """Every task of every chapter, in the book's order, each once, each experiment after the
+    experiment it warm-starts from (with as many seeds)."""
+    out: list[Task] = []
+
+    def seeds_of(t: Task) -> int:
+        return t.seeds if t.seeds is not None else get_experiment(t.name).seeds
+
+    def covered(t: Task) -> bool:
+        if t.kind != "experiment":
+            return any(o.kind == t.kind and o.options == t.options for o in out)
+        return any(o.kind == "experiment" and o.name == t.name and seeds_of(o) >= seeds_of(t) for o in out)
+
+    def add(t: Task) -> None:
+        if t.kind == "experiment":
+            for dep in sorted({c.warm_start for c in get_experiment(t.name).configs if c.warm_start}):
+                add(Task(t.chapter, dep, seeds=seeds_of(t)))
+        if not covered(t):
+            out.append(t)
+
+    for nb in chapters(book):
+        for t in chapter_requests(nb):
+            add(t)
+    return out
+
+
+# ------------------------------------------------------------------ progress
+def _duration(seconds: float | None) -> str:
+    if seconds is None or not np.isfinite(seconds):
+        return "?"
+    s = int(round(seconds))
+    return f"{s // 3600}h{s % 3600 // 60:02d}m" if s >= 3600 else f"{s // 60}m{s % 60:02d}s" if s >= 60 else f"{s}s"
+
+
+class _Bar(tqdm):
+    """A tqdm bar with one more field for its format, ``{status}``."""
+
+    def __init__(self, *args: Any, status: str = "", **kwargs: Any) -> None:
+        self.status = status
+        super().__init__(*args, **kwargs)
+
+    @property
+    def format_dict(self) -> dict[str, Any]:
+        return {**super().format_dict, "status": self.status}
+
+
+class Progress:
+    """Progress of one task: ``total`` units (runs, or measured runs) of which ``done`` were stored.
+
+    The time left is the elapsed time times the work left over the work done since the start,
+    the work of a run being its trajectory budget (an early-stopping run counts as its budget);
+    before the first unit, the time the last build recorded (``benchmarks/book_timings.json``)
+    scaled to the work left, if known. ``tty`` draws a tqdm bar; otherwise plain lines, a
+    progress line at most every ``interval`` seconds.
+    """
+
+    def __init__(self, name: str, total: int, done: int, work_left: float, unit: str = "runs",
+                 stream: TextIO | None = None, tty: bool | None = None, interval: float | None = None,
+                 previous_s: float | None = None, clock: Callable[[], float] = time.monotonic,
+                 ticker: bool = True) -> None:
+        self.name, self.total, self.done, self.unit = name, total, done, unit
+        self.stream = stream or sys.stdout
+        self.tty = self.stream.isatty() if tty is None else tty
+        self.interval = interval if interval is not None else TTY_INTERVAL if self.tty else PLAIN_INTERVAL
+        self.work_left, self.work_done, self.previous_s = float(work_left), 0.0, previous_s
+        self.trajectories = 0
+        self.clock = clock
+        self.started = self.last_line = clock()
+        self.lock = threading.Lock()
+        self.bar = None
+        if self.tty:
+            import shutil
+
+            # A terminal that does not say its width (0 columns) gets 100, not an empty bar.
+            width = shutil.get_terminal_size((100, 24)).columns
+            self.bar = _Bar(total=total, initial=done, desc=f"{PREFIX}: {name}", file=self.stream,
+                            bar_format="{desc}: {n_fmt}/{total_fmt} " + unit + " |{bar}| {status}",
+                            ncols=width if width > 0 else 100, status=self._status())
+        else:
+            self._print(f"{name}: computing {total - done} of {total} {unit} ({done} stored)"
+                        + (f", last build took {_duration(previous_s)}" if previous_s else ""))
+        self._stop = threading.Event()
+        self._thread = None
+        if ticker:
+            self._thread = threading.Thread(target=self._tick, daemon=True)
+            self._thread.start()
+
+    def _print(self, text: str) -> None:
+        print(f"{PREFIX}: {text}", file=self.stream, flush=True)
+
+    def elapsed(self) -> float:
+        return self.clock() - self.started
+
+    def left(self) -> float | None:
+        if self.work_done > 0:
+            return self.elapsed() * self.work_left / self.work_done
+        if self.previous_s is not None:
+            return max(self.previous_s - self.elapsed(), 0.0)
+        return None
+
+    def _status(self) -> str:
+        left = self.left()
+        return (f"{self.trajectories:.3g} trajectories, {_duration(self.elapsed())} elapsed, "
+                + ("time left unknown yet" if left is None else f"about {_duration(left)} left"))
+
+    def _line(self) -> None:
+        self.last_line = self.clock()
+        self._print(f"{self.name}: {self.done}/{self.total} {self.unit}, {self._status()}")
+
+    def _tick(self) -> None:
+        while not self._stop.wait(min(self.interval, 1.0)):
+            self.tick()
+
+    def tick(self) -> None:
+        """Redraw the bar, or print a progress line if ``interval`` has passed since the last."""
+        with self.lock:
+            if self.bar is not None:
+                self.bar.status = self._status()
+                self.bar.refresh()
+            elif self.clock() - self.last_line >= self.interval:
+                self._line()
+
+    def advance(self, trajectories: int, work: float, units: int = 1) -> None:
+        """``units`` more done, which simulated ``trajectories`` and were ``work`` of the work left."""
+        with self.lock:
+            self.done += units
+            self.trajectories += int(trajectories)
+            self.work_done += work
+            self.work_left = max(self.work_left - work, 0.0)
+            if self.bar is not None:
+                self.bar.status = self._status()
+                self.bar.update(units)
+            elif self.clock() - self.last_line >= self.interval and self.done < self.total:
+                self._line()
+
+    def close(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+        with self.lock:
+            if self.bar is not None:
+                self.bar.status = f"{self.trajectories:.3g} trajectories, {_duration(self.elapsed())}"
+                self.bar.close()
+            self._print(f"{self.name}: done, {self.done}/{self.total} {self.unit}, {self.trajectories:.3g} "
+                        f"trajectories in {_duration(self.elapsed())}")
+
+
+def previous_seconds(book: Path, name: str) -> float | None:
+    """The seconds the last measured build took for ``name`` (``benchmarks/book_timings.json``)."""
+    try:
+        t = json.loads((book.parent / "benchmarks" / "book_timings.json").read_text())
+        return next(float(e["seconds"]) for e in t["experiments"] if e["name"] == name)
+    except (OSError, ValueError, KeyError, TypeError, StopIteration):
+        return None
+
+
+@contextmanager
+def _reporting_stored_runs(progress: Progress) -> Iterator[None]:
+    """Tell ``progress`` of every run the runner stores (``run_configs`` stores each as it arrives)."""
+    store = runner.store_run
+
+    def store_and_report(rec: Any, folder: Path, cfg: Any, k: int) -> None:
+        store(rec, folder, cfg, k)
+        progress.advance(int(np.sum(rec.batch_size)), float(cfg.budget))
+
+    runner.store_run = store_and_report
+    try:
+        yield
+    finally:
+        runner.store_run = store
+
+
+# ------------------------------------------------------------------ the tasks
+def _say(stream: TextIO, text: str) -> None:
+    print(f"{PREFIX}: {text}", file=stream, flush=True)
+
+
+def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
+                        tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
+    """Compute the missing runs of an experiment task into ``root``; ``"stored"`` or ``"computed"``."""
+    stream = stream or sys.stdout
+    exp = scaled(get_experiment(task.name), seeds=task.seeds, budget=task.budget)
+    folder = experiment_folder(exp, root)
+    missing = [(c, k) for c in exp.configs for k in range(exp.seeds) if runner.stored_run(folder, c, k) is None]
+    total = len(exp.configs) * exp.seeds
+    if not missing:
+        _say(stream, f"{exp.name}: stored ({total} runs)")
+        return "stored"
+    work = float(sum(c.budget for c, _ in missing))
+    previous = previous_seconds(book, exp.name) if task.budget is None else None
+    if previous is not None:
+        previous *= work / sum(c.budget for c in exp.configs for _ in range(exp.seeds))
+    progress = Progress(exp.name, total, total - len(missing), work, stream=stream, tty=tty, interval=interval,
+                        previous_s=previous)
+    try:
+        with _reporting_stored_runs(progress):
+            run_experiment(exp, jobs=jobs, root=root, progress=False)
+    finally:
+        progress.close()
+    return "computed"
+
+
+def _sweep_path(root: Path, seeds: int = 1, budget: int = 1_000_000) -> Path:
+    """The file ``sweep_paths(CHAPTER_PLAN, seeds, budget)`` stores (its key, as it computes it)."""
+    from safepg.thesis.table51_sweep import CHAPTER_PLAN, SWEEP_VERSION
+
+    spec = [[asdict(v), t] for v, t in CHAPTER_PLAN]
+    key = hashlib.sha256(json.dumps([spec, seeds, budget, SWEEP_VERSION], sort_keys=True).encode()).hexdigest()[:16]
+    return root / "table-5.1-sweep" / f"{key}.json"
+
+
+def prefetch_sweep(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
+                   interval: float | None = None, book: Path = BOOK) -> str:
+    """The Table 5.1 sweep of the lqg1d chapter (``sweep_paths`` with the chapter's arguments)."""
+    from safepg.thesis.table51_sweep import sweep_paths
+
+    stream = stream or sys.stdout
+    opts = dict(task.options)
+    if _sweep_path(root, opts.get("seeds", 1), opts.get("budget", 1_000_000)).exists():
+        _say(stream, f"{task.name}: stored (1 sweep)")
+        return "stored"
+    progress = Progress(task.name, 1, 0, 1.0, unit="sweep", stream=stream, tty=tty, interval=interval,
+                        previous_s=previous_seconds(book, task.name))
+    try:
+        result = sweep_paths(root=root, **opts)
+        progress.advance(result.get("trajectories", 0), 1.0)
+    finally:
+        progress.close()
+    return "computed"
+
+
+def safety_plan(root: Path) -> list[tuple[str, Any, np.ndarray, tuple[int, ...]]]:
+    """The cart-pole chapter's safety measurements: (label, task, run's thetas, looks), one per run.
+
+    The same inputs as the chapter's cell (``measure_runs(t, runs, 1.0, RESULTS / "safety-mc",
+    looks=looks)``): the authors' two runs and each seed of ours under their settings, from their
+    theta*, and under the thesis's text. Reads the table-5.4 experiments from ``root``.
+    """
+    from safepg.thesis import authors
+    from safepg.thesis.experiments import load_experiment
+    from safepg.thesis.safety import MC_LOOKS, MC_LOOKS_OUR_RUNS
+
+    theirs, their_runs = authors.table_5_4(), authors.cartpole_runs()
+    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_env()
+    text_task = get_experiment("table-5.4").config("adaptive").make_env()
+    window = theirs["fixed"]["batches"]
+    plan = [("authors' adaptive run", task, their_runs["adaptive"]["theta"], MC_LOOKS),
+            ("authors' fixed-step run", task, their_runs["fixed"]["theta"][:window], MC_LOOKS)]
+    for name, t in (("table-5.4-authors", task), ("table-5.4-authors-theta-star", task), ("table-5.4", text_task)):
+        recs = load_experiment(name, root)
+        for cfg in ("adaptive", "N=4000"):
+            plan += [(f"{name}: {cfg}, seed {k}", t, r.theta, MC_LOOKS_OUR_RUNS) for k, r in enumerate(recs[cfg])]
+    return plan
+
+
+def safety_stored(folder: Path, env: Any, thetas: np.ndarray, looks: tuple[int, ...], sigma: float = 1.0) -> bool:
+    """Whether ``measure_runs`` has this run's measurement in ``folder`` (its key, as it computes it)."""
+    from safepg.thesis.safety import MC_ALPHA, moved_updates
+
+    T = np.ascontiguousarray(np.asarray(thetas, dtype=float))
+    ks = moved_updates(T)
+    if ks.size == 0:
+        return True
+    blob = json.dumps([repr(env), hashlib.sha256(T.tobytes()).hexdigest(), list(T.shape), float(sigma),
+                       ks.tolist(), list(looks), MC_ALPHA, 0, RESULTS_VERSION])
+    path = Path(folder) / f"{hashlib.sha256(blob.encode()).hexdigest()[:16]}.json"
+    try:
+        return json.loads(path.read_text()).get("key") == blob
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
+                    interval: float | None = None, book: Path = BOOK) -> str:
+    """The cart-pole chapter's safety measurements, run by run, with the chapter's processes per run."""
+    from safepg.thesis.safety import measure_runs
+
+    stream = stream or sys.stdout
+    folder = root / "safety-mc"
+    plan = safety_plan(root)
+    todo = [p for p in plan if not safety_stored(folder, p[1], p[2], p[3])]
+    if not todo:
+        _say(stream, f"{task.name}: stored ({len(plan)} measured runs)")
+        return "stored"
+    work = [float(len(p[2]) * p[3][-1]) for p in todo]  # updates x largest look: the most rollouts it can take
+    progress = Progress(task.name, len(plan), len(plan) - len(todo), sum(work), unit="measured runs", stream=stream,
+                        tty=tty, interval=interval, previous_s=previous_seconds(book, task.name))
+    try:
+        for (_label, env, thetas, looks), w in zip(todo, work):
+            out = measure_runs(env, [thetas], 1.0, folder, looks=looks, jobs=os.cpu_count() or 1)[0]
+            progress.advance(out.counts()["rollouts"], w)
+    finally:
+        progress.close()
+    return "computed"
+
+
+def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream: TextIO | None = None,
+             tty: bool | None = None, interval: float | None = None,
+             tasks: list[Task] | None = None) -> dict[str, str]:
+    """Compute every task the chapters need (:func:`book_tasks`) into ``root`` (default: the
+    ``results/`` beside ``book/``, the notebooks' store); returns ``{task name: "stored" | "computed"}``."""
+    stream = stream or sys.stdout
+    root = root if root is not None else book.parent / "results"
+    tasks = book_tasks(book) if tasks is None else tasks
+    started = time.monotonic()
+    _say(stream, f"{len(tasks)} computation{'s' * (len(tasks) != 1)} the chapters need, stored in {root}")
+    done = {}
+    for t in tasks:
+        kw: dict[str, Any] = dict(stream=stream, tty=tty, interval=interval, book=book)
+        if t.kind == "experiment":
+            done[t.name] = prefetch_experiment(t, root, jobs=jobs, **kw)
+        elif t.kind == "table-5.1-sweep":
+            done[t.name] = prefetch_sweep(t, root, **kw)
+        else:
+            done[t.name] = prefetch_safety(t, root, **kw)
+    computed = sum(v == "computed" for v in done.values())
+    _say(stream, f"{computed} computed, {len(done) - computed} already stored, in "
+                 f"{_duration(time.monotonic() - started)}")
+    return done
