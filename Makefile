@@ -55,7 +55,8 @@ book: setup book-assets
 bench: setup
 	$(VPY) benchmarks/bench_iteration.py
 
-# JupyterLab on the book's notebooks (book/) with this clone's kernel, on 127.0.0.1 with a
-# random token (tools/lab.sh); LAB_PORT=8888 by default, LAB_ARGS go to `jupyter lab`.
+# JupyterLab on lab/, a git-ignored working copy of the book's chapters refreshed from book/
+# without losing your edits (book/ is never written), with this clone's kernel, on 127.0.0.1
+# with a random token (tools/lab.sh); LAB_PORT=8888 by default, LAB_ARGS go to `jupyter lab`.
 lab: setup
 	@bash tools/lab.sh $(LAB_ARGS)
