@@ -174,6 +174,11 @@ def cartpole_result(p: Mapping[str, Any], traces: Mapping[str, Any], data: Mappi
                 x, y = iteration_series(r, "theta", pts, j, True)
                 plots["theta"]["series"].append({"label": f"{nm} - {nm}_0", "x": x, "color": data["theta_colors"][j],
                                                  "dash": False, "y": [None if v is None else v - theta0[j] for v in y]})
+            # The band |change| < FROZEN: a frozen theta stays inside it, at a scale that shows it.
+            band = {"x": [0, s["iterations"]], "color": "#999999", "dash": True}
+            plots["theta"]["series"] += [{**band, "label": f"+/-{_moved_text(data['frozen'])}: did not move",
+                                          "y": [data["frozen"]] * 2},
+                                         {**band, "label": "", "y": [-data["frozen"]] * 2}]
             x, y = iteration_series(r, "c", pts)
             plots["c"]["series"].append({**style, "x": x, "y": y})
             cs_text = (_exp(s["c_min"]) if s["c_min"] == s["c_max"]

@@ -59,6 +59,11 @@ const safepgCartpolePage = {
           plots.theta.series.push({label: `${nm} - ${nm}_0`, x: tx, color: data.theta_colors[j], dash: false,
                                    y: ty.map(v => v === null ? null : v - t0[j])});
         });
+        // The band |change| < frozen: a frozen theta stays inside it, at a scale that shows it.
+        const band = {x: [0, s.iterations], color: "#999999", dash: true};
+        plots.theta.series.push({...band, label: `+/-${safepgCartpoleMoved(data.frozen)}: did not move`,
+                                 y: [data.frozen, data.frozen]},
+                                {...band, label: "", y: [-data.frozen, -data.frozen]});
         [x, y] = safepgCh5IterSeries(r, "c", pts);
         plots.c.series.push({...style, x: x, y: y});
         const cText = s.c_min === s.c_max ? safepgCh5Exp(s.c_min, 2)

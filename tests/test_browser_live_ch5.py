@@ -1,0 +1,209 @@
+"""The Chapter 5 live explorers (2-D LQG, cart-pole) in headless Chromium, each rendered into its
+own page (no book build), opened from disk with every non-file request blocked: every control is
+moved and must change the figure; no console error; nothing sticks out or is cut off at 390 px;
+a long run draws as it goes and the next move cancels it; on the cart-pole, the default run
+(the thesis's text) leaves theta frozen and says so, the authors' preset moves theta_xdot.
+``test_book_cartpole_page`` is the same check on the built book (``_build/html/book/cartpole.html``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from browser_pages import OfflinePage
+
+from safepg.thesis.explorers.ch5_live import PAGE_ONLY
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "_build" / "screenshots"
+pytestmark = pytest.mark.browser
+#: Generous: the build machine is shared; a default run takes a few seconds.
+TIMEOUT_MS = 120_000
+
+
+def page_of(tmp: Path, name: str, explorer: Any) -> Path:
+    path = tmp / f"{name}.html"
+    path.write_text(f'<!doctype html><html><head><meta charset="utf-8"><meta name="viewport" '
+                    f'content="width=device-width, initial-scale=1"><title>{name}</title></head>'
+                    f"<body><main>{explorer.to_html()}</main></body></html>", encoding="utf-8")
+    return path
+
+
+@pytest.fixture(scope="module")
+def pages(tmp_path_factory) -> dict[str, tuple[Path, Any]]:
+    from safepg.thesis.explorers.cartpole_learner import cartpole_explorer
+    from safepg.thesis.explorers.lqg2d_learner import lqg2d_adaptive_explorer, lqg2d_steps_explorer
+
+    tmp = tmp_path_factory.mktemp("ch5")
+    out = {}
+    for name, ex in (("steps", lqg2d_steps_explorer()), ("adaptive", lqg2d_adaptive_explorer()),
+                     ("cartpole", cartpole_explorer())):
+        out[name] = (page_of(tmp, name, ex), ex)
+    return out
+
+
+def wait_done(pg: OfflinePage, after: int = 0) -> dict:
+    """The explorer's values once a run with a job number above ``after`` has finished."""
+    pg.page.wait_for_function(
+        """after => { const t = document.querySelector('.safepg-values').textContent;
+                      if (!t) return false; const v = JSON.parse(t);
+                      return v.job > after && v.result.values.done; }""", arg=after, timeout=TIMEOUT_MS)
+    return pg.values()
+
+
+def move(pg: OfflinePage, name: str, value: Any) -> None:
+    el = pg.page.locator(f'[data-param="{name}"]').first
+    kind = el.evaluate("e => e.type")
+    if kind == "checkbox":
+        # Through its <label>: the box must be named by the words beside it.
+        label = el.evaluate("e => e.closest('label').textContent.trim()")
+        box = pg.page.get_by_label(label, exact=True)
+        box.check() if value else box.uncheck()
+    elif kind == "select-one":
+        el.select_option(str(value))
+    else:
+        el.fill(str(value))
+
+
+def structure(res: dict) -> dict:
+    """What the page and the kernel twin must share: plot ids, series labels, value keys."""
+    vals = {k: sorted(v) if isinstance(v, dict) else v for k, v in res["values"].items() if k not in PAGE_ONLY}
+    return {"plots": {k: [s["label"] for s in p["series"]] for k, p in res["plots"].items()}, "values": vals}
+
+
+def no_overflow(pg: OfflinePage) -> None:
+    a = pg.audit()
+    assert not a["pageOverflow"] and not a["overflowing"] and not a["clipped"], a
+    cut = pg.page.evaluate("""() => [...document.querySelectorAll(
+        '.safepg-explorer label, .safepg-text, .safepg-explorer button, .safepg-status')].filter(e =>
+        e.scrollWidth > e.clientWidth + 1 || e.getBoundingClientRect().right > document.documentElement.clientWidth + 1)
+        .map(e => e.textContent.slice(0, 60))""")
+    assert not cut, cut
+
+
+def drive(browser, path: Path, explorer: Any, moves: list[tuple[str, Any]], shot: str) -> tuple[OfflinePage, dict]:
+    pg = OfflinePage(browser, path, width=1000, height=2400)
+    first = wait_done(pg)
+    assert first["result"]["values"]["worker"], "the learner must run in a Web Worker"
+    assert not first["result"]["values"]["error"], first["result"]["values"]["error"]
+    py = explorer.compute_py({**first["params"], "budget": min(first["params"]["budget"], "30000", key=int)})
+    assert structure(first["result"]) == structure(py)
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    pg.page.locator(".safepg-explorer").first.screenshot(path=str(SHOTS / f"{shot}.png"))
+    before = first
+    for name, value in moves:
+        move(pg, name, value)
+        after = wait_done(pg, before["job"])
+        assert after["params"][name] == value, (name, value, after["params"][name])
+        assert not after["result"]["values"]["error"], (name, after["result"]["values"]["error"])
+        assert after["result"]["plots"] != before["result"]["plots"], (name, value)
+        before = after
+    assert not pg.remote, pg.remote
+    assert not pg.errors, pg.errors
+    return pg, before
+
+
+def test_lqg2d_steps_explorer(browser, pages):
+    path, ex = pages["steps"]
+    moves = [("budget", "30000"), ("delta", 0.5), ("sigma", 0.75), ("bound", "bernstein-er"), ("n", "1000"),
+             ("seed", 5.0)]
+    pg, last = drive(browser, path, ex, moves, "live-lqg2d-steps")
+    v = last["result"]["values"]
+    assert v["scalar"]["trajectories"] == v["coordinate"]["trajectories"] == 30_000
+    assert [len(s["y"]) for s in last["result"]["plots"]["theta"]["series"]] == [31] * 4  # 30 updates and theta_0
+
+
+def test_lqg2d_adaptive_explorer(browser, pages):
+    path, ex = pages["adaptive"]
+    moves = [("budget", "30000"), ("delta", 0.5), ("sigma", 1.5), ("bound", "chebyshev"), ("seed", 3.0),
+             ("n_max", "10000"), ("authors", True)]
+    pg, last = drive(browser, path, ex, moves, "live-lqg2d-adaptive")
+    # Ticking the authors' switch selects their N_max (one run for both).
+    assert last["params"]["n_max"] == "100000" and last["params"]["authors"] is True
+    assert "Algorithm 4.1 (authors' settings)" in last["result"]["text"]
+
+
+def test_long_run_draws_progressively_and_is_cancelled(browser, pages):
+    path, _ = pages["adaptive"]
+    pg = OfflinePage(browser, path, width=1000, height=2400)
+    job = wait_done(pg)["job"]
+    move(pg, "budget", "3000000")
+    pg.page.wait_for_function(
+        """job => { const v = JSON.parse(document.querySelector('.safepg-values').textContent);
+                    const a = v.result.values.adaptive;
+                    return v.job === job && !v.result.values.done && a && a.trajectories > 0; }""",
+        arg=job + 1, timeout=TIMEOUT_MS)
+    assert pg.page.locator(".safepg-status").text_content().startswith("running: ")
+    partial = pg.values()["result"]["values"]["adaptive"]["trajectories"]
+    assert 0 < partial < 3_000_000
+    move(pg, "budget", "30000")  # cancels the 3*10^6 run
+    done = wait_done(pg, job + 1)
+    assert done["job"] == job + 2 and done["result"]["values"]["adaptive"]["trajectories"] == 30_000
+    assert pg.page.locator(".safepg-status").text_content().startswith("done in ")
+    assert not pg.errors and not pg.remote
+
+
+def test_cartpole_explorer(browser, pages):
+    path, ex = pages["cartpole"]
+    moves = [("budget", "10000"), ("deg12", True), ("ml005", True), ("gamma09", True), ("batch_constants", True),
+             ("max_stats", True), ("unguarded", True), ("first1000", True), ("start", "theta_star"),
+             ("delta", 0.5), ("sigma", 0.75), ("seed", 2.0), ("budget", "20000")]
+    pg, _ = drive(browser, path, ex, moves, "live-cartpole")
+    # The thesis's text, then the authors' settings: each one click.
+    job = pg.values()["job"]
+    pg.page.get_by_role("button", name="the thesis's text").click()
+    thesis = wait_done(pg, job)
+    assert thesis["job"] == job + 1  # one run for the whole preset
+    a = thesis["result"]["values"]["adaptive"]
+    assert a["frozen"] and max(a["theta_moved"]) < 1e-6
+    assert "theta did not move: " in thesis["result"]["text"]
+    pg.page.get_by_role("button", name="the authors' settings").click()
+    authors = wait_done(pg, thesis["job"])
+    a = authors["result"]["values"]["adaptive"]
+    assert all(authors["params"][b] for b in ex.data["task_boxes"]) and authors["params"]["start"] == "theta_star"
+    assert not a["frozen"] and a["theta_moved"][1] > 1e-4, a["theta_moved"]  # theta_xdot moves
+    assert "theta moved: " in authors["result"]["text"]
+    assert not pg.errors
+
+
+def test_default_cartpole_run_is_frozen(browser, pages):
+    path, _ = pages["cartpole"]
+    pg = OfflinePage(browser, path, width=1000, height=2400)
+    v = wait_done(pg)
+    assert v["result"]["values"]["elapsed_ms"] < 60_000
+    a = v["result"]["values"]["adaptive"]
+    assert a["frozen"] and "theta did not move: " in v["result"]["text"]
+    assert v["result"]["values"]["vanilla"]["theta_moved"][1] > 1e-3  # the fixed step moves it
+
+
+@pytest.mark.parametrize("name", ["steps", "adaptive", "cartpole"])
+def test_nothing_cut_off_at_390_px(browser, pages, name):
+    path, _ = pages[name]
+    pg = OfflinePage(browser, path, width=390, height=900)
+    wait_done(pg)
+    no_overflow(pg)
+    pg.page.screenshot(path=str(SHOTS / f"live-{name}-390.png"), full_page=True)
+    assert not pg.errors
+
+
+def test_book_cartpole_page(browser, book):
+    """The cart-pole page of the built book, from file://: the explorer runs in a Web Worker, its
+    default run leaves theta frozen and says so, the authors' preset moves theta_xdot, no error."""
+    pg = OfflinePage(browser, book / "book" / "cartpole.html", width=1280, height=1400)
+    root = pg.page.locator(".safepg-explorer:has([data-preset])").first
+    root.scroll_into_view_if_needed()
+    pg.page.wait_for_function(
+        """() => { const e = document.querySelector('.safepg-explorer:has([data-preset]) .safepg-values');
+                   return e && e.textContent && JSON.parse(e.textContent).result.values.done; }""",
+        timeout=TIMEOUT_MS)
+    read = lambda: __import__("json").loads(root.locator(".safepg-values").text_content())  # noqa: E731
+    v = read()
+    assert v["result"]["values"]["worker"] and v["result"]["values"]["adaptive"]["frozen"]
+    root.get_by_role("button", name="the authors' settings").click()
+    pg.page.wait_for_function(
+        """job => { const v = JSON.parse(document.querySelector('.safepg-explorer:has([data-preset]) '
+                    + '.safepg-values').textContent); return v.job > job && v.result.values.done; }""",
+        arg=v["job"], timeout=TIMEOUT_MS)
+    assert read()["result"]["values"]["adaptive"]["theta_moved"][1] > 1e-4
+    assert not pg.errors and not pg.remote
