@@ -92,24 +92,33 @@ def processes_mentioning(text: str) -> list[str]:
 
 
 class Lab:
-    """A JupyterLab server started by tools/lab.sh, and what it wrote."""
+    """A JupyterLab server started by tools/lab.sh, and what it wrote.
 
-    def __init__(self, tmp: Path) -> None:
+    The chapters' working copy goes to ``tmp/lab`` (``LAB_DIR``), never to this clone's lab/.
+    By default the server shows ``tmp/notebooks`` (the explorers' notebook) with the test's
+    settings; ``on_copy`` leaves it as `make lab` does: on the copy, with lab.sh's settings only.
+    """
+
+    def __init__(self, tmp: Path, on_copy: bool = False) -> None:
         self.tmp = tmp
+        self.copy = tmp / "lab"
         self.notebooks = tmp / "notebooks"
         self.notebooks.mkdir()
-        write_notebook(self.notebooks)
         self.runtime = tmp / "runtime"
-        write_settings(tmp / "config")
+        args = ["--ServerApp.open_browser=False", "--LabApp.expose_app_in_browser=True"]
+        if on_copy:
+            (tmp / "config").mkdir()
+        else:
+            write_notebook(self.notebooks)
+            write_settings(tmp / "config")
+            args.insert(0, f"--ServerApp.root_dir={self.notebooks}")
         env = {**os.environ, "JUPYTER_CONFIG_DIR": str(tmp / "config"), "JUPYTER_RUNTIME_DIR": str(self.runtime),
                "JUPYTER_DATA_DIR": str(tmp / "data"), "IPYTHONDIR": str(tmp / "ipython"), "TMPDIR": str(tmp),
-               "LAB_PORT": str(free_port())}
+               "LAB_PORT": str(free_port()), "LAB_DIR": str(self.copy)}
         self.log_path = tmp / "lab.log"
         self.log = self.log_path.open("w")
-        self.proc = subprocess.Popen(
-            ["bash", str(ROOT / "tools" / "lab.sh"), f"--ServerApp.root_dir={self.notebooks}",
-             "--ServerApp.open_browser=False", "--LabApp.expose_app_in_browser=True"],
-            cwd=ROOT, env=env, stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
+        self.proc = subprocess.Popen(["bash", str(ROOT / "tools" / "lab.sh"), *args], cwd=ROOT, env=env,
+                                     stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
         self.info = self._wait_started()
 
     def _wait_started(self) -> dict[str, Any]:
@@ -152,12 +161,11 @@ class Lab:
         self.log.close()
 
 
-@pytest.fixture(scope="module")
-def lab(tmp_path_factory) -> Iterator[Lab]:
+def _serve(tmp_path_factory: Any, on_copy: bool = False) -> Iterator[Lab]:
     if not (VENV / "bin" / "jupyter-lab").exists():
         pytest.fail(f"{VENV}/bin/jupyter-lab is missing: run `make setup`")
     tmp = tmp_path_factory.mktemp("lab")
-    server = Lab(tmp)
+    server = Lab(tmp, on_copy)
     try:
         yield server
     finally:
@@ -171,6 +179,16 @@ def lab(tmp_path_factory) -> Iterator[Lab]:
         shutil.rmtree(tmp, ignore_errors=True)
         assert not left, f"processes left running: {left}"
         assert not files, f"runtime files left: {files}"
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory) -> Iterator[Lab]:
+    yield from _serve(tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def lab_on_copy(tmp_path_factory) -> Iterator[Lab]:
+    yield from _serve(tmp_path_factory, on_copy=True)
 
 
 DIGEST_JS = """async el => {
@@ -319,5 +337,62 @@ def test_explorers_respond_in_jupyterlab(browser, lab):
         report["wall time of the test body (s)"] = round(time.monotonic() - started, 1)
         (SHOTS / "lab_report.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
         print("\n" + json.dumps(report, indent=1, ensure_ascii=False))
+    finally:
+        page.close()
+
+
+def _book_state() -> tuple[str, dict[str, str]]:
+    """``git status --porcelain book/`` and the bytes' hashes of every file of book/."""
+    import hashlib
+
+    status = subprocess.run(["git", "status", "--porcelain", "book/"], cwd=ROOT, capture_output=True, text=True,
+                            check=True).stdout
+    files = {str(p.relative_to(ROOT)): hashlib.sha256(p.read_bytes()).hexdigest()
+             for p in sorted((ROOT / "book").rglob("*")) if p.is_file()}
+    return status, files
+
+
+#: The chapter edited in the test: small, no experiment.
+CHAPTER = "adaptive_step.ipynb"
+MARK = "# edited in JupyterLab by test_browser_lab"
+
+
+def test_a_save_in_jupyterlab_changes_the_copy_never_book(browser, lab_on_copy):
+    lab = lab_on_copy
+    before = _book_state()
+    info = lab.info
+    page = browser.new_page(viewport={"width": 1400, "height": 1200})
+    try:
+        # The file browser shows the chapters of the copy, not book/'s plumbing.
+        page.goto(f"{info['url']}lab?token={info['token']}")
+        page.locator(".jp-DirListing-item", has_text=CHAPTER).wait_for(timeout=KERNEL_MS)
+        listed = {t.strip() for t in page.locator(".jp-DirListing-item .jp-DirListing-itemText").all_inner_texts()}
+        chapters = {p.name for p in (ROOT / "book").glob("*.ipynb")} | {"intro.md"}
+        assert chapters <= listed, f"the file browser lists {sorted(listed)}"
+        assert not listed & {"_ext", "_vendor", "_static_safepg", "tools", "_downloads"}, sorted(listed)
+
+        # Open a chapter, change its first code cell, save with Ctrl-S.
+        page.goto(f"{info['url']}lab/tree/{CHAPTER}?token={info['token']}")
+        editor = page.locator(".jp-Notebook .jp-CodeCell .cm-content").first
+        editor.wait_for(timeout=KERNEL_MS)
+        editor.click()
+        page.keyboard.press("Control+End")
+        page.keyboard.type("\n" + MARK)
+        page.keyboard.press("Control+s")
+        saved = lab.copy / CHAPTER
+        deadline = time.monotonic() + 60
+        while MARK not in saved.read_text() and time.monotonic() < deadline:
+            time.sleep(0.3)
+        assert MARK in saved.read_text(), "Ctrl-S did not save the chapter into the copy"
+        # JupyterLab never wrote book/: its git status and every file are as before.
+        assert _book_state() == before
+        assert MARK not in (ROOT / "book" / CHAPTER).read_text()
+        if not before[0]:
+            assert _book_state()[0] == "", "git status --porcelain book/ is not empty"
+        # No news popup (lab.sh's overrides: this server has no user settings of the test's).
+        page.wait_for_timeout(3000)
+        assert page.get_by_text("Jupyter news").count() == 0, "JupyterLab asked about Jupyter news"
+        SHOTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(SHOTS / "lab-copy-saved.png"))
     finally:
         page.close()
