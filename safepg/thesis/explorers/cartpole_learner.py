@@ -28,6 +28,7 @@ from safepg.thesis.explorers.ch5_live import (
     Ch5LiveExplorer,
     Reporter,
     iteration_series,
+    kernel_text,
     record_c,
     record_trace,
     trace_summary,
@@ -249,8 +250,7 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
         traces["vanilla"] = record_trace(vanilla_pg(task, theta0, sigma, rng=np.random.default_rng([seed, 1]),
                                                     progress=report(1, "fixed step"), **vanilla_options(p)))
         out = cartpole_result(p, traces, data)
-        out["values"]["done"] = True
-        return out
+        return kernel_text(out)
 
     controls: list[Any] = [Select("start", "start", tuple(options), options[0][0]),
                            *(Checkbox(name, label, False) for name, label, _, _ in SETTINGS),

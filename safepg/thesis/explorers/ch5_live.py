@@ -159,6 +159,13 @@ def trajectory_series(r: Mapping[str, Any], key: str, points: int, shift: int = 
     return [ends[k] for k in keep], [r[key][k + shift] for k in keep]
 
 
+def kernel_text(res: dict[str, Any]) -> dict[str, Any]:
+    """A page result as the kernel twin returns it: done, and its lines joined by newlines, not <br>."""
+    res["values"]["done"] = True
+    res["text"] = res["text"].replace("<br>", "\n")
+    return res
+
+
 class Ch5LiveExplorer(Explorer):
     """An :class:`~safepg.thesis.explorers.component.Explorer` whose page runs the JavaScript
     learner in a Web Worker (see the module docstring); ``compute_js`` names the page script,
@@ -214,8 +221,10 @@ class Ch5LiveExplorer(Explorer):
             b = w.Button(description=label, layout=w.Layout(width="auto"))
             b.on_click(press(values))
             buttons.append(b)
-        if buttons:
-            view.children = (view.children[0], w.HBox(buttons), *view.children[1:])
+        # compute_py's text has a line per run (kernel_text): kept as lines in the view.
+        style = w.HTML("<style>.safepg-ch5 .safepg-text span{white-space:pre-wrap}</style>")
+        view.add_class("safepg-ch5")
+        view.children = (view.children[0], *([w.HBox(buttons)] if buttons else []), *view.children[1:], style)
         return view
 
     def __repr__(self) -> str:
@@ -223,5 +232,5 @@ class Ch5LiveExplorer(Explorer):
 
 
 __all__ = ["BOUND_CHOICES", "CURVE_POINTS", "PAGE_ONLY", "Ch5LiveExplorer", "exp_text", "finite", "fixed",
-           "iteration_series", "learner_source", "record_c", "record_trace", "thin", "trace_summary",
+           "iteration_series", "kernel_text", "learner_source", "record_c", "record_trace", "thin", "trace_summary",
            "trajectory_series"]

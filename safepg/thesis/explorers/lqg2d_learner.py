@@ -32,6 +32,7 @@ from safepg.thesis.explorers.ch5_live import (
     Reporter,
     fixed,
     iteration_series,
+    kernel_text,
     record_c,
     record_trace,
     trace_summary,
@@ -149,8 +150,7 @@ def lqg2d_steps_explorer() -> Ch5LiveExplorer:
                              progress=_reporter(progress, k, 2, int(p["budget"]), STEP_LABELS[step]), **kw)
             traces[step] = record_trace(rec)
         out = steps_result(p, traces, data)
-        out["values"]["done"] = True
-        return out
+        return kernel_text(out)
 
     controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, cfg.delta),
                 Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
@@ -243,8 +243,7 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
             else:
                 traces[name] = record_trace(vanilla_pg(env, theta0, float(p["sigma"]), **kw))
         out = adaptive_result(p, traces, data)
-        out["values"]["done"] = True
-        return out
+        return kernel_text(out)
 
     controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, cfg.delta),
                 Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
