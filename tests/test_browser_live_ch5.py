@@ -3,7 +3,7 @@ own page (no book build), opened from disk with every non-file request blocked: 
 moved and must change the figure; no console error; nothing sticks out or is cut off at 390 px;
 a long run draws as it goes and the next move cancels it; on the cart-pole, the default run
 (the thesis's text) leaves theta frozen and says so, the authors' preset moves theta_xdot.
-``test_book_cartpole_page`` is the same check on the built book (``_build/html/book/cartpole.html``)."""
+The same explorers in the built book are checked by tests/test_browser_book.py."""
 
 from __future__ import annotations
 
@@ -186,24 +186,3 @@ def test_nothing_cut_off_at_390_px(browser, pages, name):
     pg.page.screenshot(path=str(SHOTS / f"live-{name}-390.png"), full_page=True)
     assert not pg.errors
 
-
-def test_book_cartpole_page(browser, book):
-    """The cart-pole page of the built book, from file://: the explorer runs in a Web Worker, its
-    default run leaves theta frozen and says so, the authors' preset moves theta_xdot, no error."""
-    pg = OfflinePage(browser, book / "book" / "cartpole.html", width=1280, height=1400)
-    root = pg.page.locator(".safepg-explorer:has([data-preset])").first
-    root.scroll_into_view_if_needed()
-    pg.page.wait_for_function(
-        """() => { const e = document.querySelector('.safepg-explorer:has([data-preset]) .safepg-values');
-                   return e && e.textContent && JSON.parse(e.textContent).result.values.done; }""",
-        timeout=TIMEOUT_MS)
-    read = lambda: __import__("json").loads(root.locator(".safepg-values").text_content())  # noqa: E731
-    v = read()
-    assert v["result"]["values"]["worker"] and v["result"]["values"]["adaptive"]["frozen"]
-    root.get_by_role("button", name="the authors' settings").click()
-    pg.page.wait_for_function(
-        """job => { const v = JSON.parse(document.querySelector('.safepg-explorer:has([data-preset]) '
-                    + '.safepg-values').textContent); return v.job > job && v.result.values.done; }""",
-        arg=v["job"], timeout=TIMEOUT_MS)
-    assert read()["result"]["values"]["adaptive"]["theta_moved"][1] > 1e-4
-    assert not pg.errors and not pg.remote
