@@ -177,12 +177,23 @@ def test_default_cartpole_run_is_frozen(browser, pages):
     assert v["result"]["values"]["vanilla"]["theta_moved"][1] > 1e-3  # the fixed step moves it
 
 
+@pytest.mark.parametrize("width", [1280, 390])
 @pytest.mark.parametrize("name", ["steps", "adaptive", "cartpole"])
-def test_nothing_cut_off_at_390_px(browser, pages, name):
+def test_nothing_cut_off(browser, pages, name, width):
+    """At a laptop's and a phone's width: nothing sticks out or is cut off, and the axes' tick
+    labels pass the book's check (tests/test_browser_book.py), under the thesis's and the authors' settings."""
+    from test_browser_book import _explorer_axes
+
     path, _ = pages[name]
-    pg = OfflinePage(browser, path, width=390, height=900)
-    wait_done(pg)
+    pg = OfflinePage(browser, path, width=width, height=900)
+    v = wait_done(pg)
     no_overflow(pg)
-    pg.page.screenshot(path=str(SHOTS / f"live-{name}-390.png"), full_page=True)
+    assert not _explorer_axes(pg), _explorer_axes(pg)
+    if name == "cartpole":
+        pg.page.get_by_role("button", name="the authors' settings").click()
+        wait_done(pg, v["job"])
+        no_overflow(pg)
+        assert not _explorer_axes(pg), _explorer_axes(pg)
+    pg.page.screenshot(path=str(SHOTS / f"live-{name}-{width}.png"), full_page=True)
     assert not pg.errors
 
