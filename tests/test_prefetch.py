@@ -166,3 +166,14 @@ def test_whole_book_run_on_a_small_plan(tmp_path, monkeypatch, capsys):
     assert lines[0].startswith("run-book: 1 computation the chapters need, stored in ")
     assert "run-book: table-5.1: stored (24 runs)" in lines
     assert lines[-1].startswith("run-book: 0 computed, 1 already stored, in ")
+
+
+def test_an_interrupted_task_says_stopped(tmp_path, monkeypatch):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(prefetch, "run_experiment", interrupted)
+    out = io.StringIO()
+    with pytest.raises(KeyboardInterrupt):
+        prefetch.prefetch_experiment(_small(), tmp_path, jobs=1, stream=out, tty=False)
+    assert out.getvalue().splitlines()[-1].startswith("run-book: table-5.1: stopped, 0/24 runs, 0 trajectories in ")

@@ -282,7 +282,8 @@ class Progress:
             elif self.clock() - self.last_line >= self.interval and self.done < self.total:
                 self._line()
 
-    def close(self) -> None:
+    def close(self, finished: bool = True) -> None:
+        """Stop the redraws and say how it ended: ``done``, or ``stopped`` (an error, Ctrl-C)."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join()
@@ -290,8 +291,8 @@ class Progress:
             if self.bar is not None:
                 self.bar.status = f"{self.trajectories:.3g} trajectories, {_duration(self.elapsed())}"
                 self.bar.close()
-            self._print(f"{self.name}: done, {self.done}/{self.total} {self.unit}, {self.trajectories:.3g} "
-                        f"trajectories in {_duration(self.elapsed())}")
+            self._print(f"{self.name}: {'done' if finished else 'stopped'}, {self.done}/{self.total} {self.unit}, "
+                        f"{self.trajectories:.3g} trajectories in {_duration(self.elapsed())}")
 
 
 def previous_seconds(book: Path, name: str) -> float | None:
@@ -344,8 +345,10 @@ def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO |
     try:
         with _reporting_stored_runs(progress):
             run_experiment(exp, jobs=jobs, root=root, progress=False)
-    finally:
-        progress.close()
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
     return "computed"
 
 
@@ -373,8 +376,10 @@ def prefetch_sweep(task: Task, root: Path, stream: TextIO | None = None, tty: bo
     try:
         result = sweep_paths(root=root, **opts)
         progress.advance(result.get("trajectories", 0), 1.0)
-    finally:
-        progress.close()
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
     return "computed"
 
 
@@ -438,8 +443,10 @@ def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: b
         for (_label, env, thetas, looks), w in zip(todo, work):
             out = measure_runs(env, [thetas], 1.0, folder, looks=looks, jobs=os.cpu_count() or 1)[0]
             progress.advance(out.counts()["rollouts"], w)
-    finally:
-        progress.close()
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
     return "computed"
 
 
