@@ -1,4 +1,5 @@
-"""Speed of the page's JavaScript learner (safepg/thesis/explorers/static/learner.js) against safepg's numba kernel.
+"""Speed of the page's JavaScript learner (safepg/thesis/explorers/static/: learner.js and the vector tasks) against
+safepg's numba kernels.
 
 Measures, on one core:
 
@@ -8,7 +9,14 @@ Measures, on one core:
 - a run: Algorithm 4.1 for 10^6 trajectories (the explorer's default settings: G(PO)MDP,
   Bernstein with the empirical range, delta = 0.95, sigma = 1), both implementations.
 
-- the same run in headless Chromium (Debian's, through Playwright): the explorer page of
+- the doubled-pole cart-pole as the authors ran it (2 m pole, m l = 0.05, 12 deg, undiscounted): 10^5
+  trajectories from their theta* (about 190 steps each), in batches of 1000 (their first batch),
+  G(PO)MDP with its baseline, random numbers included; budget: 3 s under Node;
+- the 2-D adaptive run of Figure 5.7 (table-5.3's "adaptive": gamma = 0.9, Bernstein with the
+  empirical range, delta = 0.95, n_max = 500000) at one tenth of its budget, 3*10^6
+  trajectories; budget: 2 s under Node.
+
+- the 1-D run in headless Chromium (Debian's, through Playwright): the explorer page of
   ``safepg.thesis.explorers.live_learner`` with vanilla PG off, time inside the Web Worker's learner and
   the page's time from the control move to the last curve (worker start, messages and
   drawing included), and the CPU time all of Chromium's processes used meanwhile, for a
@@ -18,7 +26,7 @@ Both wall time and process CPU time are recorded where they can be (the build ma
 shared: CPU time is the steadier figure; the browser gives wall time only). Results go to
 ``benchmarks/js_learner_timings.json``.
 
-Usage: ``python benchmarks/bench_js_learner.py [--repeat 5]``
+Usage: ``python benchmarks/bench_js_learner.py [--repeat 5] [--no-browser]``. It prints the README table's lines.
 """
 
 from __future__ import annotations
@@ -36,7 +44,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "js_learner_timings.json"
-LEARNER = ROOT / "safepg" / "thesis" / "explorers" / "static" / "learner.js"
+#: The budgets (s, under Node on the 2-core build machine) of the vector tasks' figures.
+TARGETS_S = {"cartpole_1e5": 3.0, "lqg2d_fig57_tenth": 2.0}
 
 NODE_BENCH = r"""
 const L = require(process.argv[2]);
@@ -59,6 +68,22 @@ for (const est of ["gpomdp", "reinforce"])
                                                        {estimator: est, baseline: true, score: "clipped"}, ws, draw));
 let seed = 0;
 out.run_1e6 = time(() => new L.Run({bound: "bernstein", empiricalRange: true, budget: 1000000, seed: seed++}).finish());
+const vec = JSON.parse(process.argv[4]);
+const cp = new L.CartpoleBatch(vec.cartpole), cpSrc = L.rngSource(new L.Rng(1, 0)), star = Float64Array.from(vec.theta);
+let steps = 0;
+out.cartpole_1e5 = time(() => {
+  steps = 0;
+  for (let b = 0; b < 100; b++) {
+    cp.run(star, 1, 1000, {estimator: "gpomdp", baseline: true, score: "clipped"}, cpSrc);
+    for (let j = 0; j < 1000; j++) steps += cp.returns[j];
+  }
+});
+out.cartpole_1e5.mean_steps = steps / 1e5;
+out.lqg2d_fig57_tenth = time(() => {
+  const cfg = {bound: "bernstein", empiricalRange: true, budget: 3000000, seed: seed++};
+  const r = new L.VectorRun(cfg, vec.lqg2d).finish();
+  out.lqg2d_fig57_tenth_iterations = r.rec.batchSize.length;
+});
 process.stdout.write(JSON.stringify(out));
 """
 
@@ -127,6 +152,7 @@ def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--no-browser", action="store_true", help="skip the headless Chromium runs")
     args = ap.parse_args()
     node = shutil.which("node")
     if node is None:
@@ -134,23 +160,40 @@ def main() -> None:
     import numba
 
     from safepg import LQG, adaptive_pg
+    from safepg.envs.cartpole import CartPole
     from safepg.policies import LinearGaussianPolicy
+    from safepg.thesis.authors import cartpole_theta_star
+    from safepg.thesis.experiments import AUTHORS_DOUBLED, make_env
+    from safepg.thesis.explorers.js_tasks import cartpole_task_data, learner_sources, lqg_task_data
 
     numba.set_num_threads(1)
+    cartpole, lqg2d = CartPole.thesis_doubled(**AUTHORS_DOUBLED), make_env("lqg2d-gamma0.9")
+    star = cartpole_theta_star()
+    vec = {"cartpole": cartpole_task_data(cartpole), "lqg2d": lqg_task_data(lqg2d), "theta": star.tolist()}
     with tempfile.TemporaryDirectory() as tmp:
-        script = Path(tmp) / "bench.js"
+        script, learner = Path(tmp) / "bench.js", Path(tmp) / "learner_all.js"
         script.write_text(NODE_BENCH)
-        js = json.loads(subprocess.run([node, str(script), str(LEARNER),
-                                        str(args.repeat)], capture_output=True, text=True, check=True).stdout)
+        learner.write_text(learner_sources())
+        js = json.loads(subprocess.run([node, str(script), str(learner), str(args.repeat), json.dumps(vec)],
+                                       capture_output=True, text=True, check=True).stdout)
     env = LQG.thesis_1d()
     policy = LinearGaussianPolicy([[-0.3]], 1.0)
     rng = np.random.default_rng(0)
     py = {f"batch_1e5_{est}": best_of(lambda est=est: env.gradient_batch(policy, 100_000, rng, est), args.repeat)
           for est in ("gpomdp", "reinforce")}
     seeds = iter(range(1000))
+    # Trajectory-steps of each measurement, for the per-step figures.
+    steps = {"batch_1e5_gpomdp": 2e6, "batch_1e5_reinforce": 2e6, "run_1e6": 2e7, "lqg2d_fig57_tenth": 6e7,
+             "cartpole_1e5": 1e5 * js["cartpole_1e5"]["mean_steps"]}
     py["run_1e6"] = best_of(lambda: adaptive_pg(env, 0.0, 1.0, bound="bernstein", empirical_range=True,
                                                 budget=1_000_000, rng=next(seeds)), args.repeat)
-    browser = chromium_runs(args.repeat)
+    star_policy = LinearGaussianPolicy(star.reshape(1, 4), 1.0)
+    py["cartpole_1e5"] = best_of(lambda: [cartpole.gradient_batch(star_policy, 1000, rng) for _ in range(100)],
+                                 args.repeat)
+    py["lqg2d_fig57_tenth"] = best_of(lambda: adaptive_pg(lqg2d, np.zeros(4), 1.0, bound="bernstein",
+                                                          empirical_range=True, budget=3_000_000, rng=next(seeds)),
+                                      args.repeat)
+    browser = None if args.no_browser else chromium_runs(args.repeat)
     result = {
         "what": "best of --repeat calls; batch: N = 1e5 trajectories, H = 20, random numbers included; run: "
                 "Algorithm 4.1, G(PO)MDP, Bernstein (e.r.), delta 0.95, sigma 1, 1e6 trajectories",
@@ -164,12 +207,20 @@ def main() -> None:
                                                   "page_best_s": min(browser["page_s"]),
                                                   "browser_cpu_best_s": min(browser["browser_cpu_s"])},
         "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"],
-                                    "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]} for k in js},
-        "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / (2e6 if k.startswith("batch") else 2e7)
-                            for impl, v in (("js", js), ("numba", py)) for k in v},
+                                    "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]} for k in py},
+        "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / steps[k]
+                            for impl, v in (("js", js), ("numba", py)) for k in py},
+        "targets_s": {k: {"target": t, "js_cpu_s": js[k]["cpu_ms"] / 1e3, "js_wall_s": js[k]["wall_ms"] / 1e3,
+                          "met_cpu": js[k]["cpu_ms"] / 1e3 <= t} for k, t in TARGETS_S.items()},
     }
     OUT.write_text(json.dumps(result, indent=1) + "\n")
     print(json.dumps(result, indent=1))
+    print("\nREADME table lines:")
+    for k, label in (("cartpole_1e5", "cart-pole, 10^5 episodes of the authors' doubled pole from theta* "
+                                      f"({js['cartpole_1e5']['mean_steps']:.0f} steps each)"),
+                     ("lqg2d_fig57_tenth", "2-D LQG, Figure 5.7's adaptive run at 3*10^6 trajectories")):
+        print(f"| {label} | {js[k]['cpu_ms'] / 1e3:.2f} s | {py[k]['cpu_ms'] / 1e3:.2f} s | "
+              f"{TARGETS_S[k]:.0f} s |")
 
 
 if __name__ == "__main__":

@@ -164,7 +164,7 @@ def agreement(name: str, seeds: int = SEEDS) -> tuple[list[dict[str, Any]], list
     js = run_node({"seeds": [{"task": data, "cfg": {**cfg, "theta0": THETA_STAR.tolist(), "seed": k}}
                              for k in range(seeds)]})["seeds"]
     py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
-    values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar for r in py]),
+    values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
               "final theta_2": ([s["theta_final"][2] for s in js], [r.theta[-1, 2] for r in py]),
               "iterations": ([s["iterations"] for s in js], [r.iterations for r in py])}
     moved_js = [s["moved"] for s in js]

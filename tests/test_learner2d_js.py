@@ -356,7 +356,7 @@ def agreement(name: str, seeds: int = SEEDS) -> list[dict[str, Any]]:
     call, cfg = SETTINGS[name]
     js = run_node({"seeds": [{"task": TASK, "cfg": {**cfg, "seed": k}} for k in range(seeds)]})["seeds"]
     py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
-    values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar for r in py]),
+    values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
               "final J": ([s["J_final"] for s in js], [r.J[-1] for r in py]),
               "final theta_00": ([s["theta_final"][0] for s in js], [r.theta[-1, 0] for r in py]),
               "iterations": ([s["iterations"] for s in js], [r.iterations for r in py])}

@@ -192,6 +192,7 @@
    * Returns null (LQG has no per-batch maxima).
    */
   LqgBatch.prototype.run = function (theta, sigma, n, opt, src) {
+    if (this.m === 2) return this.run2(theta, sigma, n, opt, src);
     const task = this.task, m = this.m, M = this.M, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
     const A = task.A, B = task.B, Q = task.Q, R = task.R;
@@ -263,6 +264,88 @@
       }
     } else if (baseline) {
       for (let i = 0; i < M * n; i++) samples[i] -= acc[i];
+    }
+    return null;
+  };
+
+  /**
+   * run() for m = 2 with the 2 x 2 algebra unrolled (the 2-D kernel of safepg): the same sums
+   * in the same order as the generic loop, so the same bits, about three times faster.
+   */
+  LqgBatch.prototype.run2 = function (theta, sigma, n, opt, src) {
+    const task = this.task, H = task.H, gamma = task.gamma;
+    const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    this.grow(n);
+    const s = this.s, z = this.z, G = this.G, samples = this.samples, acc = this.acc, returns = this.returns;
+    const [k00, k01, k10, k11] = theta, [a00, a01, a10, a11] = task.A, [b00, b01, b10, b11] = task.B;
+    const [q00, q01, q10, q11] = task.Q, [r00, r01, r10, r11] = task.R;
+    const iv = 1.0 / (sigma * sigma), n2 = 2 * n, n3 = 3 * n;
+    src.init(s, n, 2, -bs, bs);
+    G.fill(0, 0, 4 * n); samples.fill(0, 0, 4 * n); acc.fill(0, 0, 4 * n); returns.fill(0, 0, n);
+    let disc = 1.0;
+    // The baseline term of step t - 1 (b of the previous step, 0 at t = 0) joins step t's pass over
+    // the batch: the same terms added in the same order as a pass of their own, one pass fewer.
+    const gb = !reinforce && baseline;
+    let b0 = 0, b1 = 0, b2 = 0, b3 = 0;
+    for (let t = 0; t < H; t++) {
+      src.step(z, n, 2, t, this.idx);
+      let n0 = 0, n1 = 0, nn2 = 0, nn3 = 0, d0 = 0, d1 = 0, d2 = 0, d3 = 0;
+      for (let j = 0; j < n; j++) {
+        const x0 = s[j], x1 = s[n + j];
+        const h0 = G[j], h1 = G[n + j], h2 = G[n2 + j], h3 = G[n3 + j];
+        if (gb && t > 0) {
+          acc[j] += h0 * b0; acc[n + j] += h1 * b1; acc[n2 + j] += h2 * b2; acc[n3 + j] += h3 * b3;
+        }
+        const m0 = 0.0 + k00 * x0 + k01 * x1, m1 = 0.0 + k10 * x0 + k11 * x1;
+        const a0 = m0 + sigma * z[j], a1 = m1 + sigma * z[n + j];
+        const u0 = clip ? Math.min(Math.max(a0, -ba), ba) : a0, u1 = clip ? Math.min(Math.max(a1, -ba), ba) : a1;
+        let cost = 0.0 + (x0 * q00 * x0 + u0 * r00 * u0);
+        cost += x0 * q01 * x1 + u0 * r01 * u1;
+        cost += x1 * q10 * x0 + u1 * r10 * u0;
+        cost += x1 * q11 * x1 + u1 * r11 * u1;
+        const dr = -0.5 * cost * disc;
+        returns[j] += dr;
+        const e0 = iv * ((scoreClipped ? u0 : a0) - m0), e1 = iv * ((scoreClipped ? u1 : a1) - m1);
+        const g0 = h0 + e0 * x0, g1 = h1 + e0 * x1, g2 = h2 + e1 * x0, g3 = h3 + e1 * x1;
+        G[j] = g0; G[n + j] = g1; G[n2 + j] = g2; G[n3 + j] = g3;
+        if (!reinforce) {
+          samples[j] += g0 * dr; samples[n + j] += g1 * dr; samples[n2 + j] += g2 * dr; samples[n3 + j] += g3 * dr;
+          n0 += g0 * g0 * dr; n1 += g1 * g1 * dr; nn2 += g2 * g2 * dr; nn3 += g3 * g3 * dr;
+          d0 += g0 * g0; d1 += g1 * g1; d2 += g2 * g2; d3 += g3 * g3;
+        }
+        const y0 = 0.0 + (a00 * x0 + b00 * u0) + (a01 * x1 + b01 * u1);
+        const y1 = 0.0 + (a10 * x0 + b10 * u0) + (a11 * x1 + b11 * u1);
+        s[j] = clip ? Math.min(Math.max(y0, -bs), bs) : y0;
+        s[n + j] = clip ? Math.min(Math.max(y1, -bs), bs) : y1;
+      }
+      if (gb) {
+        b0 = d0 !== 0 ? n0 / d0 : 0; b1 = d1 !== 0 ? n1 / d1 : 0;
+        b2 = d2 !== 0 ? nn2 / d2 : 0; b3 = d3 !== 0 ? nn3 / d3 : 0;
+      }
+      disc *= gamma;
+    }
+    if (gb) {
+      for (let j = 0; j < n; j++) {
+        acc[j] += G[j] * b0; acc[n + j] += G[n + j] * b1; acc[n2 + j] += G[n2 + j] * b2; acc[n3 + j] += G[n3 + j] * b3;
+      }
+    }
+    if (reinforce) {
+      for (let p = 0; p < 4; p++) {
+        const o = p * n;
+        let nb = 0.0, db = 0.0;
+        for (let j = 0; j < n; j++) {
+          const g = G[o + j], sq = g * g;
+          nb += sq * returns[j]; db += sq;
+          samples[o + j] = g * returns[j];
+        }
+        if (baseline) {
+          const bp = db !== 0 ? nb / db : 0;
+          for (let j = 0; j < n; j++) samples[o + j] -= G[o + j] * bp;
+        }
+      }
+    } else if (baseline) {
+      for (let i = 0; i < 4 * n; i++) samples[i] -= acc[i];
     }
     return null;
   };
