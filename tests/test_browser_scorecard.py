@@ -176,7 +176,8 @@ def test_every_row_links_to_a_section_that_exists(browser, scorecard_page):
         assert f'id="{anchor}"' in text, (r["id"], r["links"][0])
     # The summary counts agree with the rows (its last column counts every part of the thesis).
     counts = pg.page.evaluate("""() => { const t = document.querySelector('table.sc-summary');
-        return [...t.querySelectorAll('tbody tr')].map(tr => Number([...tr.querySelectorAll('td')].pop().textContent)); }""")
+        return [...t.querySelectorAll('tbody tr')].map(
+            tr => Number([...tr.querySelectorAll('td')].pop().textContent)); }""")
     by_status = [sum(r["status"] == s for r in rows) for s in STATUSES]
     flagged = pg.page.evaluate("() => document.querySelectorAll('tr.sc-row .sc-noinfo').length")
     assert counts == [*by_status, len(rows), flagged]
