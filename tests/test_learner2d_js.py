@@ -330,13 +330,13 @@ def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
 SEEDS = 30
 #: name -> (safepg call, the JavaScript cfg); budgets small enough for a minute in all.
 SETTINGS: dict[str, tuple[Any, dict[str, Any]]] = {
-    "adaptive, Bernstein (e.r.), 3*10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=300_000, rng=s),
-        {"bound": "bernstein", "empiricalRange": True, "budget": 300_000}),
-    "adaptive, authors' options, 3*10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=300_000, rng=s,
+    "adaptive, Bernstein (e.r.), 10^5": (
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=100_000, rng=s),
+        {"bound": "bernstein", "empiricalRange": True, "budget": 100_000}),
+    "adaptive, authors' options, 10^5": (
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=100_000, rng=s,
                               n_max=100_000, statistics="max", step_when_unsafe=True),
-        {"bound": "bernstein", "empiricalRange": True, "budget": 300_000, "nMax": 100_000, "statistics": "max",
+        {"bound": "bernstein", "empiricalRange": True, "budget": 100_000, "nMax": 100_000, "statistics": "max",
          "stepWhenUnsafe": True}),
     "scalar step of [24], N = 2000, 10^5": (
         lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step="scalar", budget=100_000, rng=s),
@@ -359,6 +359,7 @@ def agreement(name: str, seeds: int = SEEDS) -> list[dict[str, Any]]:
     values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
               "final J": ([s["J_final"] for s in js], [r.J[-1] for r in py]),
               "final theta_00": ([s["theta_final"][0] for s in js], [r.theta[-1, 0] for r in py]),
+              "final theta_01": ([s["theta_final"][1] for s in js], [r.theta[-1, 1] for r in py]),
               "iterations": ([s["iterations"] for s in js], [r.iterations for r in py])}
     return welch_rows(f"2-D LQG: {name}", values)
 
@@ -369,8 +370,8 @@ def test_runs_agree_statistically(name):
     rows = agreement(name)
     print("\n" + table(rows))
     for row in rows:
-        if row["metric"] == "iterations" and row["half_ci99"] == 0:
-            assert row["diff"] == 0
+        if row["half_ci99"] == 0:  # every seed the same (a fixed batch size, an entry no step moves)
+            assert row["diff"] == 0, row
             continue
         assert row["inside"], row
 
