@@ -12,7 +12,7 @@ import pytest
 
 from safepg.cli import main
 from safepg.envs.lqg import LQG
-from safepg.thesis import prefetch, safety, table51_sweep
+from safepg.thesis import prefetch, safety_store, table51_sweep
 from safepg.thesis.budget import CHAPTER_EXPERIMENTS
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiments import EXPERIMENTS, SWEEP_SEEDS, get_experiment
@@ -137,10 +137,10 @@ def test_tty_bar_shows_runs_trajectories_and_time_left():
 def test_stored_checks_agree_with_the_caches(tmp_path, monkeypatch):
     thetas = np.array([-0.3, -0.4, -0.4, -0.5])[:, None]
     env = LQG.thesis_1d(clip=False, horizon=150)
-    assert not prefetch.safety_stored(tmp_path, env, thetas, (300, 600))
-    safety.measure_runs(env, [thetas], 1.0, tmp_path, looks=(300, 600))
-    assert prefetch.safety_stored(tmp_path, env, thetas, (300, 600))
-    assert not prefetch.safety_stored(tmp_path, env, thetas, (300, 1200))
+    assert not safety_store.is_measured(tmp_path, env, thetas, 1.0, (300, 600))
+    safety_store.measure_runs(env, [thetas], 1.0, tmp_path, looks=(300, 600))
+    assert safety_store.is_measured(tmp_path, env, thetas, 1.0, (300, 600))
+    assert not safety_store.is_measured(tmp_path, env, thetas, 1.0, (300, 1200))
 
     plan = ((table51_sweep.DEFAULT, -0.575),)
     monkeypatch.setattr(table51_sweep, "CHAPTER_PLAN", plan)

@@ -9,7 +9,7 @@ import pytest
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
 from safepg.policies import LinearGaussianPolicy
-from safepg.thesis import safety
+from safepg.thesis import safety, safety_store
 
 # The unclipped 1-D LQG over a long horizon: its simulated J is the closed form up to 0.9^150 ~ 1e-7.
 ENV = LQG.thesis_1d(clip=False, horizon=150)
@@ -101,16 +101,16 @@ def test_same_inputs_same_outcomes_and_bad_inputs_refused():
 
 def test_cache_returns_the_stored_measurement(tmp_path, monkeypatch):
     kw = dict(updates=np.array([1, 2]), looks=(300, 600), seed=2)
-    first = safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **kw)
+    first = safety_store.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **kw)
     assert len(list(tmp_path.glob("*.json"))) == 1
 
     def fail(*args, **kwargs):
         raise AssertionError("recomputed a stored measurement")
 
-    monkeypatch.setattr(safety, "monte_carlo_changes", fail)
-    assert safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **kw).to_json() == first.to_json()
+    monkeypatch.setattr(safety_store, "monte_carlo_changes", fail)
+    assert safety_store.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **kw).to_json() == first.to_json()
     with pytest.raises(AssertionError, match="recomputed"):  # other inputs: not the stored one
-        safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **{**kw, "seed": 3})
+        safety_store.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, **{**kw, "seed": 3})
 
 
 def test_normal_quantile():
@@ -122,9 +122,10 @@ def test_normal_quantile():
 
 def test_measure_runs_takes_every_update_that_moved_theta(tmp_path):
     runs = [THETAS[:5], THETAS[4:]]  # the second run holds the update that does not move theta (its k = 2)
-    out = safety.measure_runs(ENV, runs, 1.0, tmp_path, looks=(300, 600), seed=4)
+    out = safety_store.measure_runs(ENV, runs, 1.0, tmp_path, looks=(300, 600), seed=4)
     assert [o.updates.tolist() for o in out] == [[0, 1, 2, 3], [0, 1, 3, 4]]
-    one = safety.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 1, 3, 4]), (300, 600), seed=4)
+    one = safety_store.cached_monte_carlo_changes(tmp_path, ENV, runs[1], 1.0, np.array([0, 1, 3, 4]), (300, 600),
+                                                  seed=4)
     assert out[1].to_json() == one.to_json()
     assert len(list(tmp_path.glob("*.json"))) == 2  # one file per run, read back above
     for o, T in zip(out, runs):  # the counts add up to the run's updates
@@ -133,7 +134,7 @@ def test_measure_runs_takes_every_update_that_moved_theta(tmp_path):
     pooled = safety.MonteCarloOutcomes.join(out)
     assert pooled.updates.tolist() == [0, 1, 2, 3, 0, 1, 3, 4] and pooled.steps == out[0].steps + out[1].steps
     # A run that never moved: nothing measured, nothing stored (the time budget reads every stored file).
-    still = safety.measure_runs(ENV, [np.repeat(THETAS[:1], 4, axis=0)], 1.0, tmp_path, looks=(300, 600))
+    still = safety_store.measure_runs(ENV, [np.repeat(THETAS[:1], 4, axis=0)], 1.0, tmp_path, looks=(300, 600))
     assert still[0].updates.size == 0 and still[0].counts()["share_lowered_upper95"] is None
     assert len(list(tmp_path.glob("*.json"))) == 2
     with pytest.raises(ValueError, match="looks"):
@@ -143,12 +144,12 @@ def test_measure_runs_takes_every_update_that_moved_theta(tmp_path):
 def test_parallel_measurement_is_the_serial_one(tmp_path):
     ks = np.array([0, 2, 3, 5, 6, 8])
     serial = safety.monte_carlo_changes(ENV, THETAS, 1.0, ks, looks=(300, 1200), seed=5)
-    par = safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300, 1200), seed=5, jobs=2)
+    par = safety_store.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300, 1200), seed=5, jobs=2)
     assert par.to_json() == serial.to_json()
     stored = json.loads(next(tmp_path.glob("*.json")).read_text())
     assert stored["seconds"] > 0 and stored["outcomes"]["steps"] == serial.steps > 0  # what the budget reads
     with pytest.raises(ValueError, match="jobs"):
-        safety.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300,), jobs=0)
+        safety_store.cached_monte_carlo_changes(tmp_path, ENV, THETAS, 1.0, ks, (300,), jobs=0)
 
 
 def test_counts_add_up_on_a_cart_pole_measurement():

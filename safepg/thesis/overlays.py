@@ -469,7 +469,7 @@ def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], lab
 
 
 def figure_cartpole_safety(measured: Mapping[str, Any]) -> Figure:
-    """Each measured update's change of J with its interval (:func:`safepg.thesis.safety.measure_runs`).
+    """Each measured update's change of J with its interval (:func:`safepg.thesis.safety_store.measure_runs`).
 
     ``measured`` maps a label to a :class:`~safepg.thesis.safety.MonteCarloOutcomes` (one run, or
     several joined by :meth:`~safepg.thesis.safety.MonteCarloOutcomes.join`); labels with

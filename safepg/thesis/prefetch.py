@@ -25,7 +25,6 @@ starts, one when it ends, and at most one progress line every :data:`PLAIN_INTER
 from __future__ import annotations
 
 import ast
-import hashlib
 import json
 import os
 import re
@@ -34,7 +33,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -42,7 +41,6 @@ import numpy as np
 from tqdm import tqdm
 
 from safepg import runner
-from safepg.runner import RESULTS_VERSION
 from safepg.thesis.experiments import EXPERIMENTS, experiment_folder, get_experiment, run_experiment, scaled
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
@@ -353,12 +351,10 @@ def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO |
 
 
 def _sweep_path(root: Path, seeds: int = 1, budget: int = 1_000_000) -> Path:
-    """The file ``sweep_paths(CHAPTER_PLAN, seeds, budget)`` stores (its key, as it computes it)."""
-    from safepg.thesis.table51_sweep import CHAPTER_PLAN, SWEEP_VERSION
+    """The file ``sweep_paths(CHAPTER_PLAN, seeds, budget)`` stores."""
+    from safepg.thesis.table51_sweep import CHAPTER_PLAN, sweep_file
 
-    spec = [[asdict(v), t] for v, t in CHAPTER_PLAN]
-    key = hashlib.sha256(json.dumps([spec, seeds, budget, SWEEP_VERSION], sort_keys=True).encode()).hexdigest()[:16]
-    return root / "table-5.1-sweep" / f"{key}.json"
+    return sweep_file(CHAPTER_PLAN, seeds, budget, root)
 
 
 def prefetch_sweep(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
@@ -384,55 +380,31 @@ def prefetch_sweep(task: Task, root: Path, stream: TextIO | None = None, tty: bo
 
 
 def safety_plan(root: Path) -> list[tuple[str, Any, np.ndarray, tuple[int, ...]]]:
-    """The cart-pole chapter's safety measurements: (label, task, run's thetas, looks), one per run.
+    """The cart-pole chapter's safety measurements, one per run: (label, task, run's thetas, looks).
 
-    The same inputs as the chapter's cell (``measure_runs(t, runs, 1.0, RESULTS / "safety-mc",
-    looks=looks)``): the authors' two runs and each seed of ours under their settings, from their
-    theta*, and under the thesis's text. Reads the table-5.4 experiments from ``root``.
+    :func:`safepg.thesis.safety_store.table_5_4_runs`, the chapter's own list, run by run; the
+    table-5.4 experiments are read from ``root``.
     """
     from safepg.thesis import authors
     from safepg.thesis.experiments import load_experiment
-    from safepg.thesis.safety import MC_LOOKS, MC_LOOKS_OUR_RUNS
+    from safepg.thesis.safety_store import table_5_4_runs
 
-    theirs, their_runs = authors.table_5_4(), authors.cartpole_runs()
-    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_env()
-    text_task = get_experiment("table-5.4").config("adaptive").make_env()
-    window = theirs["fixed"]["batches"]
-    plan = [("authors' adaptive run", task, their_runs["adaptive"]["theta"], MC_LOOKS),
-            ("authors' fixed-step run", task, their_runs["fixed"]["theta"][:window], MC_LOOKS)]
-    for name, t in (("table-5.4-authors", task), ("table-5.4-authors-theta-star", task), ("table-5.4", text_task)):
-        recs = load_experiment(name, root)
-        for cfg in ("adaptive", "N=4000"):
-            plan += [(f"{name}: {cfg}, seed {k}", t, r.theta, MC_LOOKS_OUR_RUNS) for k, r in enumerate(recs[cfg])]
-    return plan
-
-
-def safety_stored(folder: Path, env: Any, thetas: np.ndarray, looks: tuple[int, ...], sigma: float = 1.0) -> bool:
-    """Whether ``measure_runs`` has this run's measurement in ``folder`` (its key, as it computes it)."""
-    from safepg.thesis.safety import MC_ALPHA, moved_updates
-
-    T = np.ascontiguousarray(np.asarray(thetas, dtype=float))
-    ks = moved_updates(T)
-    if ks.size == 0:
-        return True
-    blob = json.dumps([repr(env), hashlib.sha256(T.tobytes()).hexdigest(), list(T.shape), float(sigma),
-                       ks.tolist(), list(looks), MC_ALPHA, 0, RESULTS_VERSION])
-    path = Path(folder) / f"{hashlib.sha256(blob.encode()).hexdigest()[:16]}.json"
-    try:
-        return json.loads(path.read_text()).get("key") == blob
-    except (OSError, ValueError, AttributeError):
-        return False
+    records = {name: load_experiment(name, root)
+               for name in ("table-5.4-authors", "table-5.4-authors-theta-star", "table-5.4")}
+    runs = table_5_4_runs(records, authors.cartpole_runs(), authors.table_5_4()["fixed"]["batches"])
+    return [(f"{label}, run {k}", task, thetas, looks)
+            for label, (task, thetas_list, looks) in runs.items() for k, thetas in enumerate(thetas_list)]
 
 
 def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
                     interval: float | None = None, book: Path = BOOK) -> str:
     """The cart-pole chapter's safety measurements, run by run, with the chapter's processes per run."""
-    from safepg.thesis.safety import measure_runs
+    from safepg.thesis.safety_store import is_measured, measure_runs
 
     stream = stream or sys.stdout
     folder = root / "safety-mc"
     plan = safety_plan(root)
-    todo = [p for p in plan if not safety_stored(folder, p[1], p[2], p[3])]
+    todo = [p for p in plan if not is_measured(folder, p[1], p[2], 1.0, p[3])]
     if not todo:
         _say(stream, f"{task.name}: stored ({len(plan)} measured runs)")
         return "stored"

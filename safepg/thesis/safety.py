@@ -15,24 +15,18 @@ the step :math:`\Lambda^*` does not lower the performance :math:`J`, provided th
 counts, from a learning record, how many updates lowered the closed-form :math:`J`;
 :func:`monte_carlo_changes` measures the same with a Monte Carlo :math:`J` on tasks without a closed
 form (the cart-pole), with common random numbers and a 99% interval per update
-(:func:`cached_monte_carlo_changes` keeps the result in the results folder, :func:`measure_runs`
-takes every update of each run). Both summaries give, per run, the updates that lowered, raised or
+(:mod:`safepg.thesis.safety_store` keeps the results in the results folder and measures every
+update of each run). Both summaries give, per run, the updates that lowered, raised or
 left undetermined :math:`J`, the one-sided 95% Clopper-Pearson bound on the share of updates that
 lower it (:func:`clopper_pearson_upper`) and the detection floor of the Monte Carlo measurement.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
-import os
-import tempfile
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -41,7 +35,7 @@ from safepg import portable
 from safepg.envs.cartpole import CartPole
 from safepg.learning import LearningRecord
 from safepg.policies import LinearGaussianPolicy
-from safepg.runner import RESULTS_VERSION, RunConfig
+from safepg.runner import RunConfig
 
 
 def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
@@ -500,98 +494,3 @@ def monte_carlo_changes(env: Any, thetas: np.ndarray, sigma: float, updates: np.
     outcome = np.where(result[:, 2] < 0, "lowered", np.where(result[:, 1] > 0, "raised", "undetermined"))
     return MonteCarloOutcomes(ks, result[:, 0], result[:, 1], result[:, 2], used, outcome.astype(str),
                               tuple(int(n) for n in looks), alpha, steps)
-
-
-def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma: float,
-                               updates: np.ndarray | None = None, looks: tuple[int, ...] = MC_LOOKS,
-                               alpha: str = MC_ALPHA, seed: int = 0, jobs: int = 1) -> MonteCarloOutcomes:
-    """:func:`monte_carlo_changes`, stored in ``folder`` under a key of all its inputs.
-
-    The file ``<key>.json`` is written atomically (a temporary file renamed over it, as the run
-    store does); a file that cannot be read, or was made by other inputs, is computed again.
-    It also records the ``seconds`` the measurement took (wall time; the time budget reads them,
-    with the ``steps`` its rollouts lived). Without updates nothing is simulated or stored.
-
-    ``jobs`` > 1 measures the updates in that many joblib processes, update ``i`` of the list in
-    process ``i % jobs``. Each update's rollouts are seeded by the update and the look alone, so
-    the outcomes are the same for any ``jobs``; it is not part of the key.
-    """
-    T = np.ascontiguousarray(np.asarray(thetas, dtype=float))
-    ks = np.arange(T.shape[0] - 1) if updates is None else np.asarray(updates, dtype=int)
-    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
-        raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
-    if ks.size == 0:
-        return monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
-    blob = json.dumps([repr(env), hashlib.sha256(T.tobytes()).hexdigest(), list(T.shape), float(sigma),
-                       ks.tolist(), list(looks), alpha, seed, RESULTS_VERSION])
-    key = hashlib.sha256(blob.encode()).hexdigest()[:16]
-    path = Path(folder) / f"{key}.json"
-    try:
-        stored = json.loads(path.read_text())
-        if stored.get("key") == blob:
-            return MonteCarloOutcomes.from_json(stored["outcomes"])
-    except (OSError, ValueError, KeyError, TypeError):
-        pass
-    started = time.perf_counter()
-    jobs = int(min(jobs, ks.size))
-    if jobs == 1:
-        out = monte_carlo_changes(env, T, sigma, ks, looks, alpha, seed)
-    else:
-        from joblib import Parallel, delayed
-
-        parts = Parallel(n_jobs=jobs)(delayed(_one_thread_changes)(env, T, sigma, ks[j::jobs], looks, alpha, seed)
-                                      for j in range(jobs))
-        joined = MonteCarloOutcomes.join(parts)
-        order = np.argsort(np.concatenate([np.arange(ks.size)[j::jobs] for j in range(jobs)]), kind="stable")
-        out = MonteCarloOutcomes(*(getattr(joined, f)[order] for f in ("updates", "change", "lower", "upper",
-                                                                        "rollouts", "outcome")),
-                                 looks=joined.looks, alpha=joined.alpha, steps=joined.steps)
-    seconds = time.perf_counter() - started  # benchmarks/bench_book.py and safepg.thesis.budget read it
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{key}~", suffix=".tmp")
-    with os.fdopen(fd, "w") as f:
-        json.dump({"key": blob, "outcomes": out.to_json(), "seconds": round(seconds, 3)}, f)
-    os.replace(tmp, path)
-    return out
-
-
-def _one_thread_changes(*args: Any) -> MonteCarloOutcomes:
-    """:func:`monte_carlo_changes` in a joblib process, its kernels on one thread (the processes
-    share the cores; a batch does not depend on the thread count, ``safepg.streams``)."""
-    import numba
-
-    numba.set_num_threads(1)
-    return monte_carlo_changes(*args)
-
-
-def measure_runs(env: Any, runs: Sequence[np.ndarray], sigma: float, folder: Path,
-                 looks: tuple[int, ...] = MC_LOOKS, alpha: str = MC_ALPHA, seed: int = 0,
-                 jobs: int = 1) -> list[MonteCarloOutcomes]:
-    """:func:`cached_monte_carlo_changes` on every update of each run that moved theta, run by run.
-
-    Parameters
-    ----------
-    env : task
-        The task the runs learned on.
-    runs : sequence of arrays (I + 1, m)
-        Each run's parameters in the order visited (a record's ``theta``, or the authors' logged
-        theta column).
-    sigma : float
-        The policies' standard deviation.
-    folder : Path
-        Where the measurements are stored (one file per run).
-    looks, alpha, seed
-        As in :func:`monte_carlo_changes`: the last look sets the detection floor of the updates
-        that stay undetermined.
-    jobs : int
-        Processes per run (:func:`cached_monte_carlo_changes`; the outcomes do not depend on it).
-
-    Returns
-    -------
-    list of MonteCarloOutcomes
-        One per run, every update k with theta[k + 1] != theta[k] (:func:`moved_updates`), in
-        order; :meth:`MonteCarloOutcomes.counts` summarises a run, :meth:`MonteCarloOutcomes.join`
-        pools several.
-    """
-    return [cached_monte_carlo_changes(folder, env, T, sigma, moved_updates(T), looks, alpha, seed, jobs)
-            for T in runs]

@@ -331,6 +331,13 @@ def _theta0_key(theta0: float) -> str:
     return f"{theta0:g}"
 
 
+def sweep_file(plan: Sequence[tuple[Variant, float]], seeds: int, budget: int, root: Path) -> Path:
+    """The file that stores :func:`sweep_paths` of ``(plan, seeds, budget)`` under the results folder ``root``."""
+    spec = [[asdict(v), t] for v, t in plan]
+    key = hashlib.sha256(json.dumps([spec, seeds, budget, SWEEP_VERSION], sort_keys=True).encode()).hexdigest()[:16]
+    return root / "table-5.1-sweep" / f"{key}.json"
+
+
 def sweep_paths(plan: Sequence[tuple[Variant, float]] = CHAPTER_PLAN, seeds: int = 1, budget: int = 1_000_000,
                 jobs: int = 1, root: Path | None = None) -> dict[str, Any]:
     """Parameter paths of every (variant, theta_0) of ``plan``, cell and seed, computed once and stored.
@@ -352,10 +359,8 @@ def sweep_paths(plan: Sequence[tuple[Variant, float]] = CHAPTER_PLAN, seeds: int
         raise ValueError(f"seeds must be a positive integer, got {seeds}")
     if int(budget) != budget or budget < max(n for _, n, _, _ in table_cells()):
         raise ValueError(f"budget must be an integer >= the largest batch size 10000, got {budget}")
-    root = root or results_dir()
     spec = [[asdict(v), t] for v, t in plan]
-    key = hashlib.sha256(json.dumps([spec, seeds, budget, SWEEP_VERSION], sort_keys=True).encode()).hexdigest()[:16]
-    path = root / "table-5.1-sweep" / f"{key}.json"
+    path = sweep_file(plan, seeds, budget, root or results_dir())
     if path.exists():
         return json.loads(path.read_text())
     tasks = [(v, t, s, n, a, k) for v, t in plan for s, n, a, _ in table_cells() for k in range(seeds)
