@@ -46,7 +46,7 @@ def skip_or_fail(reason: str) -> None:
 
 
 def build_book() -> Path:
-    """Fetch the vendored assets and build the book with warnings as errors.
+    """Fetch the vendored assets, compute what the chapters need and build the book with warnings as errors.
 
     Returns
     -------
@@ -55,6 +55,8 @@ def build_book() -> Path:
     """
     subprocess.run(["bash", "book/tools/vendor_assets.sh"], cwd=ROOT, check=True)
     subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
+    # As `make book`: the chapters' experiments first (progress lines), then the pages from the stored runs.
+    subprocess.run([sys.executable, "-m", "safepg", "run-book"], cwd=ROOT, check=True)
     subprocess.run([JUPYTER_BOOK, "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
                    stdout=subprocess.DEVNULL)
     return HTML
