@@ -136,7 +136,13 @@ class Explorer:
         return {"plots": [p.__dict__ for p in self.plots], "data": self.data}
 
     def _controls_html(self) -> str:
-        """The sliders and selects, as labelled form elements the page's script reads."""
+        """The sliders and selects, as labelled form elements the page's script reads.
+
+        Each control sits in the ``<label>`` that names it (its accessible name is the visible
+        label); a slider's shown value is ``aria-hidden``, since the slider itself announces
+        its value and the name should not change as it moves. The page's script names any
+        control that reaches it without a label (``safepgName`` in ``runtime.js``).
+        """
         style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
         rows = []
         for c in self.controls:
@@ -147,7 +153,8 @@ class Explorer:
             elif isinstance(c, Slider):
                 rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
                             f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
-                            f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')
+                            f'style="vertical-align:middle"> '
+                            f'<output data-show="{c.name}" aria-hidden="true">{c.value}</output></label>')
             else:
                 opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
                                f"{html.escape(lbl)}</option>" for v, lbl in c.options)

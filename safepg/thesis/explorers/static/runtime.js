@@ -115,8 +115,16 @@ function safepgParam(inp) {
   if (inp.type === "checkbox") return inp.checked;
   return inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value);
 }
+function safepgName(inp) {
+  // Every control gets an accessible name: the <label> around it (component.py's markup), or
+  // else its data-label or parameter name, so a control type added later is never nameless.
+  const labelled = inp.getAttribute("aria-label") || inp.getAttribute("aria-labelledby")
+    || [...(inp.labels || [])].some(l => l.textContent.trim());
+  if (!labelled) inp.setAttribute("aria-label", inp.dataset.label || inp.dataset.param);
+}
 function safepgExplorer(root, spec, compute, lib) {
   const inputs = root.querySelectorAll("[data-param]");
+  inputs.forEach(safepgName);
   const valuesEl = root.querySelector(".safepg-values");
   function params() {
     const p = {};
