@@ -1,7 +1,8 @@
 // safepg book: mark every box of the text column that scrolls sideways (a wide table, a long
 // formula, a long printed line) with the class safepg-scrollable and add a visible
 // "scroll sideways" cue below it; the cue goes away when the box fits. Reruns after MathJax
-// has typeset the page and whenever the window is resized.
+// has typeset the page and whenever the window is resized. Also gives the theme's and
+// myst-nb's controls accessible names that contain their visible words (nameControls).
 (function () {
   "use strict";
   const HINT = "safepg-scroll-hint";
@@ -64,9 +65,37 @@
     }
   }
 
+  function nameControls() {
+    // Accessible names that contain the visible label (WCAG 2.5.3, axe's
+    // label-content-name-mismatch), so a speech-input user can say what they see.
+    // myst-nb names every "Show code cell source" toggle "Toggle hidden content": drop that
+    // name and let the visible words name it.
+    for (const s of document.querySelectorAll("details.hide > summary[aria-label]")) s.removeAttribute("aria-label");
+    // The theme's search field shows "Search Ctrl+K" but is named "Search": name it by its
+    // words, and tell assistive technology about the shortcut.
+    for (const b of document.querySelectorAll("button.search-button__button[aria-label]")) {
+      if (!b.querySelector(".search-button__kbd-shortcut")) continue;
+      b.removeAttribute("aria-label");
+      b.setAttribute("aria-keyshortcuts", "Control+K");
+    }
+    // The theme's colour-mode button ("Color mode") holds icons titled Light / Dark / System
+    // Settings (Font Awesome turns the title into the SVG's name): icons are decoration here.
+    for (const i of document.querySelectorAll(".theme-switch-button .theme-switch")) {
+      i.removeAttribute("title");
+      if (i.tagName.toLowerCase() === "svg") {
+        i.querySelectorAll("title").forEach(t => t.remove());
+        i.removeAttribute("aria-labelledby");
+        i.removeAttribute("role");
+        i.setAttribute("aria-hidden", "true");
+      }
+    }
+  }
+
   let timer = null;
   function later() { clearTimeout(timer); timer = setTimeout(mark, 150); }
+  document.addEventListener("DOMContentLoaded", nameControls);
   window.addEventListener("load", () => {
+    nameControls();  // again: Font Awesome replaces its <i> icons by SVGs after DOMContentLoaded
     liftCaptions();
     mark();
     if (window.MathJax && MathJax.startup && MathJax.startup.promise) MathJax.startup.promise.then(mark);
