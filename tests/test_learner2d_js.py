@@ -215,18 +215,24 @@ def test_closed_forms_match_safepg():
                                                            ("gpomdp", False, "raw", True),
                                                            ("reinforce", True, "clipped", True),
                                                            ("gpomdp", True, "raw", False)])
-def test_gradient_samples_match_the_kernel(estimator, baseline, score, clip, tmp_path):
-    env = replace(ENV, clip=clip)
-    theta, sigma, n, seed = np.array([-0.3, 0.05, -0.02, -0.25]), 0.8, 1500, 11
-    policy = LinearGaussianPolicy(theta.reshape(2, 2), sigma)
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gradient_samples_match_the_kernel(estimator, baseline, score, clip, dim, tmp_path):
+    env = replace(ENV, clip=clip, dim=dim)
+    m = dim * dim
+    theta = np.array([-0.3, 0.05, -0.02, -0.25]) if dim == 2 else -0.2 * np.eye(3).ravel() + 0.01
+    sigma, n, seed = 0.8, 1500, 11
+    policy = LinearGaussianPolicy(theta.reshape(dim, dim), sigma)
     samples, returns = env.gradient_batch(policy, n, np.random.default_rng(seed), estimator, baseline, score)
-    U, Z = replay_draws(seed, [n], 2, env.horizon * 2)
-    q = {"task": lqg_task_data(env), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": 4, "H": env.horizon,
-         "opt": {"estimator": estimator, "baseline": baseline, "score": score},
+    batch = env.simulate(policy, n, np.random.default_rng(seed))
+    U, Z = replay_draws(seed, [n], dim, env.horizon * dim)
+    q = {"task": lqg_task_data(env), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": m, "H": env.horizon,
+         "opt": {"estimator": estimator, "baseline": baseline, "score": score, "constants": "batch"},
          "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}
     js = run_node({"batch": [q]})["batch"][0]
-    close_to_scale(np.array(js["samples"]).reshape(4, n).T, samples)
+    close_to_scale(np.array(js["samples"]).reshape(m, n).T, samples)
     np.testing.assert_allclose(js["returns"], returns, rtol=RTOL)
+    # constants="batch": the largest |reward| and |feature| of the batch, as safepg.learning measures them
+    assert js["found"] == pytest.approx([np.abs(batch.rewards).max(), np.abs(batch.features).max()], rel=RTOL)
 
 
 def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, float] | None,

@@ -189,7 +189,8 @@
    * n gradient samples (this.samples, component p of trajectory j at p * n + j) and discounted
    * returns (this.returns) with gain theta. src.init(s, n, m, lo, hi) fills the initial states
    * (s[i * n + j] uniform in [lo, hi)); src.step(z, n, m, t, idx) the step's standard normals.
-   * Returns null (LQG has no per-batch maxima).
+   * Returns, with opt.constants = "batch", the batch's [max |r_t|, max |s_i|] over its steps
+   * (what safepg.learning measures on a simulated batch), else null.
    */
   LqgBatch.prototype.run = function (theta, sigma, n, opt, src) {
     if (this.m === 2) return this.run2(theta, sigma, n, opt, src);
@@ -205,7 +206,8 @@
     src.init(s, n, m, -bs, bs);
     G.fill(0, 0, M * n); samples.fill(0, 0, M * n); acc.fill(0, 0, M * n); returns.fill(0, 0, n);
     num.fill(0); den.fill(0);
-    let disc = 1.0;
+    let disc = 1.0, rmax = 0, fmax = 0;
+    const maxima = opt.constants === "batch";
     for (let t = 0; t < H; t++) {
       src.step(z, n, m, t, this.idx);
       const to = t * M;
@@ -224,6 +226,10 @@
         }
         const dr = -0.5 * cost * disc;
         returns[j] += dr;
+        if (maxima) {
+          rmax = Math.max(rmax, Math.abs(-0.5 * cost));
+          for (let i = 0; i < m; i++) fmax = Math.max(fmax, Math.abs(s[i * n + j]));
+        }
         for (let i = 0; i < m; i++) diff[i] = invVar * ((scoreClipped ? u[i] : araw[i]) - mean[i]);
         for (let i = 0; i < m; i++) for (let k = 0; k < m; k++) {
           const p = i * m + k, o = p * n + j;
@@ -265,7 +271,7 @@
     } else if (baseline) {
       for (let i = 0; i < M * n; i++) samples[i] -= acc[i];
     }
-    return null;
+    return maxima ? [rmax, fmax] : null;
   };
 
   /**
@@ -283,7 +289,8 @@
     const iv = 1.0 / (sigma * sigma), n2 = 2 * n, n3 = 3 * n;
     src.init(s, n, 2, -bs, bs);
     G.fill(0, 0, 4 * n); samples.fill(0, 0, 4 * n); acc.fill(0, 0, 4 * n); returns.fill(0, 0, n);
-    let disc = 1.0;
+    let disc = 1.0, rmax = 0, fmax = 0;
+    const maxima = opt.constants === "batch";
     // The baseline term of step t - 1 (b of the previous step, 0 at t = 0) joins step t's pass over
     // the batch: the same terms added in the same order as a pass of their own, one pass fewer.
     const gb = !reinforce && baseline;
@@ -306,6 +313,7 @@
         cost += x1 * q11 * x1 + u1 * r11 * u1;
         const dr = -0.5 * cost * disc;
         returns[j] += dr;
+        if (maxima) rmax = Math.max(rmax, Math.abs(-0.5 * cost), 0), fmax = Math.max(fmax, Math.abs(x0), Math.abs(x1));
         const e0 = iv * ((scoreClipped ? u0 : a0) - m0), e1 = iv * ((scoreClipped ? u1 : a1) - m1);
         const g0 = h0 + e0 * x0, g1 = h1 + e0 * x1, g2 = h2 + e1 * x0, g3 = h3 + e1 * x1;
         G[j] = g0; G[n + j] = g1; G[n2 + j] = g2; G[n3 + j] = g3;
@@ -347,7 +355,7 @@
     } else if (baseline) {
       for (let i = 0; i < 4 * n; i++) samples[i] -= acc[i];
     }
-    return null;
+    return maxima ? [rmax, fmax] : null;
   };
 
   Object.assign(L, {lqgTask, THESIS_2D, lqgPerformanceN, lqgGradientN, lqgSolve: solve, lqgStable: stable, LqgBatch});

@@ -147,8 +147,10 @@
     this.grad = new Float64Array(m);
     this.used = 0; this.n = first; this.done = false; this.diverged = false;
     this.rec = {batchSize: [], alpha: [], coordinate: [], eps: [], Jhat: [], grad: [], safe: [], nextN: [], c: [],
-                theta: [Array.from(this.theta)], J: [this.performance()]};
+                theta: [this.vec(this.theta)], J: [this.performance()]};
   }
+  /** A vector as the record keeps it: an array, or a number on the 1-D LQG (as learner.js's Run). */
+  VectorRun.prototype.vec = function (v) { return this.m === 1 ? v[0] : Array.from(v); };
   VectorRun.prototype.performance = function () {
     if (this.task.kind !== "lqg") return null;
     const J = L.lqgPerformanceN(this.theta, this.cfg.sigma, this.task);
@@ -181,8 +183,8 @@
     this.used += n;
     const r = this.rec;
     r.batchSize.push(n); r.alpha.push(up.alpha); r.coordinate.push(up.k); r.eps.push(up.eps); r.Jhat.push(Jhat);
-    r.grad.push(Array.from(grad)); r.safe.push(up.safe); r.nextN.push(up.nextN); r.c.push(up.c);
-    r.theta.push(Array.from(this.theta)); r.J.push(this.performance());
+    r.grad.push(this.vec(grad)); r.safe.push(up.safe); r.nextN.push(up.nextN); r.c.push(up.c);
+    r.theta.push(this.vec(this.theta)); r.J.push(this.performance());
     this.n = up.nextN;
     return true;
   };
@@ -239,10 +241,19 @@
             Q: task.Q[0], Rc: task.R[0], R: task.rewardBound, M: task.featureBound, Avol: task.actionVolume,
             Abar: task.actionBound, clip: task.clip};
   }
-  /** A run for any task: learner.js's Run for the 1-D LQG (so its numbers do not change), else a VectorRun. */
+  /** Whether a cfg sets an option learner.js's 1-D Run does not have. */
+  function needsVectorRun(cfg) {
+    const d = VECTOR_DEFAULTS, c = cfg || {};
+    return ["nFirst", "constants", "statistics", "stepWhenUnsafe", "step", "stopOnDivergence"]
+      .some(k => c[k] !== undefined && c[k] !== d[k]) || c.alpha === null;
+  }
+  /**
+   * A run for any task: learner.js's Run for the 1-D LQG (so its numbers do not change) unless the
+   * cfg needs an option only VectorRun has; else a VectorRun.
+   */
   function makeRun(cfg, task) {
     if (!task || !task.kind) return new L.Run(cfg, task);
-    if (task.kind === "lqg" && task.dim === 1) return new L.Run(cfg, oneDTask(task));
+    if (task.kind === "lqg" && task.dim === 1 && !needsVectorRun(cfg)) return new L.Run(cfg, oneDTask(task));
     return new VectorRun(cfg, task);
   }
   L.Driver.makeRun = makeRun;
