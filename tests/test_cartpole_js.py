@@ -165,7 +165,7 @@ def agreement(name: str, seeds: int = SEEDS) -> tuple[list[dict[str, Any]], list
                              for k in range(seeds)]})["seeds"]
     py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
     values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
-              "|theta_final - theta*|_1": ([np.abs(np.array(s["theta_final"]) - THETA_STAR).sum() for s in js],
+              "L1 distance theta_final - theta*": ([np.abs(np.array(s["theta_final"]) - THETA_STAR).sum() for s in js],
                                            [np.abs(r.theta[-1] - THETA_STAR).sum() for r in py]),
               "iterations": ([s["iterations"] for s in js], [r.iterations for r in py])}
     moved_js = [s["moved"] for s in js]
