@@ -12,10 +12,14 @@ its markup, or named by its script when a control comes without a label) must no
 Every explorer control on the built pages has an accessible name, is reached with Tab, and
 moves with the keyboard: ArrowRight on a slider must change the plotted SVG.
 
-What the book does to pass (see ``book/_static_safepg/safepg-book.js``, ``nameControls``):
-myst-nb's "Show code cell source" toggles, the theme's search field ("Search Ctrl+K") and
-colour-mode button (icons titled Light / Dark) had accessible names that did not contain
-their visible words (rule ``label-content-name-mismatch``).
+What the book does to pass: code is coloured with accessible-pygments' high-contrast light
+and dark styles (``book/_static_safepg/safepg-book.css``; Jupyter Book 1's "sphinx" pygments
+style failed ``color-contrast`` on most code cells, badly in the dark theme), and
+``nameControls`` in ``book/_static_safepg/safepg-book.js`` gives myst-nb's "Show code cell
+source" toggles and the theme's search field ("Search Ctrl+K") and colour-mode button
+(icons titled Light / Dark) names that contain their visible words
+(``label-content-name-mismatch``). Only pages of ``_toc.yml`` are audited: the build's
+``reports/`` holds execution logs that no page links to.
 """
 
 from __future__ import annotations
