@@ -158,6 +158,8 @@ def test_axe_catches_unlabelled_controls(browser, axe_js, tmp_path):
     names = _control_names(pg, "#explorer .safepg-explorer")
     assert names == {"a": "Noise σ", "shape": "Shape", "extra": "Offset",
                      **({"flip": "Flip the curve"} if "flip" in names else {})}, names
+    # the numbers under the plot are read out after a move
+    assert pg.page.locator("#explorer .safepg-text").get_attribute("aria-live") == "polite"
     assert not pg.errors
 
 

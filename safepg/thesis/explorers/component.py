@@ -177,7 +177,8 @@ class Explorer:
             f'border-radius:6px;padding:0.8em;margin:1em 0">'
             f'<div style="font-weight:600;margin-bottom:0.4em">{html.escape(self.title)}</div>'
             f'{self._controls_html()}{self._plots_html()}'
-            '<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
+            # aria-live: a screen reader reads the new numbers after each move of a control
+            '<div class="safepg-text" aria-live="polite" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
             f'<script>(function(){{\n{static_text("lib.js")}\n{static_text("runtime.js")}'
             f"const spec={spec};"
