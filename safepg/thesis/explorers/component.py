@@ -139,9 +139,11 @@ class Explorer:
         """The sliders and selects, as labelled form elements the page's script reads.
 
         Each control sits in the ``<label>`` that names it (its accessible name is the visible
-        label); a slider's shown value is ``aria-hidden``, since the slider itself announces
-        its value and the name should not change as it moves. The page's script names any
-        control that reaches it without a label (``safepgName`` in ``runtime.js``).
+        label). The page's script (``safepgA11y`` in ``runtime.js``, not here, so that the
+        notebooks' stored outputs, which nbval compares, stay as they are) hides a slider's
+        shown value from assistive technology (the slider announces its value itself, and its
+        name should not change as it moves), names any control that comes without a label,
+        and makes the numbers under the plot an ``aria-live`` region.
         """
         style = 'style="display:inline-block;margin:0 1.2em 0.4em 0"'
         rows = []
@@ -153,8 +155,7 @@ class Explorer:
             elif isinstance(c, Slider):
                 rows.append(f'<label {style}>{html.escape(c.label)} <input type="range" data-param="{c.name}" '
                             f'min="{c.min}" max="{c.max}" step="{c.step}" value="{c.value}" '
-                            f'style="vertical-align:middle"> '
-                            f'<output data-show="{c.name}" aria-hidden="true">{c.value}</output></label>')
+                            f'style="vertical-align:middle"> <output data-show="{c.name}">{c.value}</output></label>')
             else:
                 opts = "".join(f'<option value="{html.escape(v)}"{" selected" if v == c.value else ""}>'
                                f"{html.escape(lbl)}</option>" for v, lbl in c.options)
@@ -177,8 +178,7 @@ class Explorer:
             f'border-radius:6px;padding:0.8em;margin:1em 0">'
             f'<div style="font-weight:600;margin-bottom:0.4em">{html.escape(self.title)}</div>'
             f'{self._controls_html()}{self._plots_html()}'
-            # aria-live: a screen reader reads the new numbers after each move of a control
-            '<div class="safepg-text" aria-live="polite" style="font-family:monospace;font-size:0.9em"></div>'
+            '<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
             f'<script>(function(){{\n{static_text("lib.js")}\n{static_text("runtime.js")}'
             f"const spec={spec};"

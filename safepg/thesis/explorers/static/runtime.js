@@ -115,16 +115,24 @@ function safepgParam(inp) {
   if (inp.type === "checkbox") return inp.checked;
   return inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value);
 }
-function safepgName(inp) {
+function safepgA11y(root, inputs) {
   // Every control gets an accessible name: the <label> around it (component.py's markup), or
   // else its data-label or parameter name, so a control type added later is never nameless.
-  const labelled = inp.getAttribute("aria-label") || inp.getAttribute("aria-labelledby")
-    || [...(inp.labels || [])].some(l => l.textContent.trim());
-  if (!labelled) inp.setAttribute("aria-label", inp.dataset.label || inp.dataset.param);
+  // A slider's shown value is hidden from assistive technology: the slider announces its
+  // value itself, and its name (the label's words) should not change as it moves. The
+  // numbers under the plot are read out after each move (aria-live).
+  inputs.forEach(inp => {
+    const labelled = inp.getAttribute("aria-label") || inp.getAttribute("aria-labelledby")
+      || [...(inp.labels || [])].some(l => l.textContent.trim());
+    if (!labelled) inp.setAttribute("aria-label", inp.dataset.label || inp.dataset.param);
+  });
+  root.querySelectorAll("output[data-show]").forEach(o => o.setAttribute("aria-hidden", "true"));
+  const text = root.querySelector(".safepg-text");
+  if (text) text.setAttribute("aria-live", "polite");
 }
 function safepgExplorer(root, spec, compute, lib) {
   const inputs = root.querySelectorAll("[data-param]");
-  inputs.forEach(safepgName);
+  safepgA11y(root, inputs);
   const valuesEl = root.querySelector(".safepg-values");
   function params() {
     const p = {};
