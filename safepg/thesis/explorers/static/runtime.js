@@ -115,17 +115,20 @@ function safepgParam(inp) {
   if (inp.type === "checkbox") return inp.checked;
   return inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value);
 }
-function safepgA11y(root, inputs) {
+function safepgName(inp) {
   // Every control gets an accessible name: the <label> around it (component.py's markup), or
   // else its data-label or parameter name, so a control type added later is never nameless.
-  // A slider's shown value is hidden from assistive technology: the slider announces its
-  // value itself, and its name (the label's words) should not change as it moves. The
-  // numbers under the plot are read out after each move (aria-live).
-  inputs.forEach(inp => {
-    const labelled = inp.getAttribute("aria-label") || inp.getAttribute("aria-labelledby")
-      || [...(inp.labels || [])].some(l => l.textContent.trim());
-    if (!labelled) inp.setAttribute("aria-label", inp.dataset.label || inp.dataset.param);
-  });
+  // (ch5_page.js calls it too.)
+  const labelled = inp.getAttribute("aria-label") || inp.getAttribute("aria-labelledby")
+    || [...(inp.labels || [])].some(l => l.textContent.trim());
+  if (!labelled) inp.setAttribute("aria-label", inp.dataset.label || inp.dataset.param);
+}
+function safepgA11y(root, inputs) {
+  // Every control named (safepgName). A slider's shown value is hidden from assistive
+  // technology: the slider announces its value itself, and its name (the label's words)
+  // should not change as it moves. The numbers under the plot are read out after each move
+  // (aria-live).
+  inputs.forEach(safepgName);
   root.querySelectorAll("output[data-show]").forEach(o => o.setAttribute("aria-hidden", "true"));
   const text = root.querySelector(".safepg-text");
   if (text) text.setAttribute("aria-live", "polite");
