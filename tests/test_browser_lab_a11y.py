@@ -3,9 +3,9 @@
 JupyterLab is started as ``tests/test_browser_lab.py`` starts it (its ``Lab`` server and
 notebook of the three explorers' ``.interactive()`` views). Then, on every view: axe-core
 (``tests/test_browser_a11y.py``'s pinned copy) reports no serious or critical violation
-inside the view, less :data:`EXCLUSIONS`, and every control has an accessible name (known
-to fail, marked xfail: the figure has no alt text, see the test); and a slider moved with the
-keyboard alone (focus its handle, ArrowRight) redraws the figure for the new value.
+inside the view, less :data:`EXCLUSIONS`, every control has an accessible name and the figure
+has alt text; and a slider moved with the keyboard alone (focus its handle, ArrowRight)
+redraws the figure for the new value.
 """
 
 from __future__ import annotations
@@ -93,12 +93,6 @@ def test_sliders_move_by_keyboard(browser, lab):
         page.close()
 
 
-#: Known and ours to fix: the kernel view's figure is an ``ipywidgets.Image``, which has no
-#: alt trait (safepg/thesis/explorers/kernel_view.py would draw it as an <img> with alt text).
-#: While it is the only violation left the test is an expected failure; any other fails it.
-KNOWN_FIGURE_ALT = ("image-alt", ".safepg-interactive img.safepg-figure")
-
-
 def test_views_pass_axe(browser, lab, axe_js):
     """axe-core inside the views (less :data:`EXCLUSIONS`), and every control named."""
     page, views, errors = _open(browser, lab)
@@ -124,11 +118,9 @@ def test_views_pass_axe(browser, lab, axe_js):
             if nameless:
                 problems.append(f"{name}: controls without an accessible name: {nameless}")
         assert not errors, errors
-        is_figure = "([t, s]) => document.querySelector(t).matches(s)"
-        known = [v for v in found if v["id"] == KNOWN_FIGURE_ALT[0]
-                 and all(page.evaluate(is_figure, [n["target"], KNOWN_FIGURE_ALT[1]]) for n in v["nodes"])]
-        if problems and len(problems) == len(known) == 1:
-            pytest.xfail(f"only the known one: {problems[0][:160]}")
+        alts = page.evaluate("() => [...document.querySelectorAll('.safepg-interactive img.safepg-figure')]"
+                             ".map(img => img.alt)")
+        assert len(alts) == len(views) and all(len(a.split()) >= 8 for a in alts), alts
         assert not problems, "\n".join(problems)
     finally:
         page.close()

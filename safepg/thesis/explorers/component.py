@@ -79,19 +79,11 @@ class Select:
 
 @dataclass(frozen=True)
 class Checkbox:
-    """An on/off switch; the page passes ``true``/``false`` (``p[name]`` is a bool).
-
-    ``options`` lets a view that knows only sliders and selects (the kernel view) offer it
-    as a yes/no choice with the same bool values.
-    """
+    """An on/off switch; the page passes ``true``/``false`` (``p[name]`` is a bool)."""
 
     name: str
     label: str
     value: bool = False
-
-    @property
-    def options(self) -> tuple[tuple[bool, str], ...]:
-        return ((True, "yes"), (False, "no"))
 
 
 @dataclass(frozen=True)

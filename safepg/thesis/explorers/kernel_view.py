@@ -17,13 +17,14 @@ with safepg). So that a slider move always gets an answer, an :class:`ExplorerVi
   the last good figure, and prints no traceback (the exception is kept in
   :attr:`ExplorerView.last_error`).
 
-The figure is a PNG drawn with matplotlib's object-oriented API into an
-``ipywidgets.Image``: pyplot's global figure list is not for threads, and an image widget
-is updated by assigning its bytes, which ipywidgets sends to the page from any thread.
+The figure is a PNG drawn with matplotlib's object-oriented API (pyplot's global figure list is
+not for threads) into an ``<img>`` with alt text in an ``ipywidgets.HTML``, which is updated by
+assigning its value, which ipywidgets sends to the page from any thread.
 """
 
 from __future__ import annotations
 
+import base64
 import html
 import io
 import json
@@ -111,6 +112,20 @@ def result_text(res: dict[str, Any]) -> str:
     return ", ".join(f"{k} = {_short(v)}" for k, v in vals.items() if isinstance(v, int | float))
 
 
+def figure_alt(explorer: Any) -> str:
+    """The figure's alt text: what each of its plots draws against what, and where its numbers are."""
+    parts = [f"{p.ylabel or p.id} against {p.xlabel}" if p.xlabel else (p.ylabel or p.id) for p in explorer.plots]
+    return (f"{explorer.kernel_title or explorer.title}: {'; '.join(parts)}, for the values of the controls "
+            "above; the numbers are in the text below the figure.")
+
+
+def figure_html(explorer: Any, png: bytes, width: int) -> str:
+    """The figure as an ``<img>`` with alt text (:func:`figure_alt`), ``width`` px wide at most."""
+    src = "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+    return (f'<img class="safepg-figure" src="{src}" alt="{html.escape(figure_alt(explorer), quote=True)}" '
+            f'style="width:{width}px;max-width:100%;height:auto">')
+
+
 class ExplorerView(w.VBox):
     """An explorer's controls, status, progress bar and figure, computed in a worker thread.
 
@@ -133,7 +148,7 @@ class ExplorerView(w.VBox):
         error line (empty unless the newest values failed) and the result's text.
     progress : ipywidgets.FloatProgress
         Fraction done, shown while a computation that reports progress runs.
-    figure : ipywidgets.Image
+    figure : ipywidgets.HTML
         The PNG of the newest result.
     drawn : dict or None
         The control values the figure shows.
@@ -148,7 +163,10 @@ class ExplorerView(w.VBox):
         self.controls: dict[str, w.ValueWidget] = {}
         style = {"description_width": "initial"}
         for c in explorer.controls:
-            if not hasattr(c, "options"):  # a Slider; a Select has options
+            if not hasattr(c, "options") and not hasattr(c, "min"):  # a Checkbox
+                ctl = w.Checkbox(value=bool(c.value), description=c.label, indent=False, style=style,
+                                 layout=w.Layout(width="auto"))
+            elif not hasattr(c, "options"):  # a Slider; a Select has options
                 ctl = w.FloatSlider(value=c.value, min=c.min, max=c.max, step=c.step, description=c.label,
                                     continuous_update=explorer.continuous_update, style=style,
                                     layout=w.Layout(width="auto", min_width="260px"))
@@ -164,10 +182,11 @@ class ExplorerView(w.VBox):
         self.progress.add_class("safepg-progress")
         self.error = w.HTML()
         self.error.add_class("safepg-error")
-        # Shown at its own size (render_png's 100 dpi), narrowed to the output area if wider.
-        width = round(explorer.plot_width * len(explorer.plots) * 100)
-        self.figure = w.Image(format="png", layout=w.Layout(width=f"{width}px", max_width="100%", height="auto"))
-        self.figure.add_class("safepg-figure")
+        # An <img> in an HTML widget, not ipywidgets.Image, which cannot carry alt text. Shown at
+        # its own size (render_png's 100 dpi), narrowed to the output area if wider.
+        self._figure_width = round(explorer.plot_width * len(explorer.plots) * 100)
+        self.figure = w.HTML()
+        self.figure.add_class("safepg-figure-box")
         self.text = w.HTML()
         self.text.add_class("safepg-text")
         self.drawn: dict[str, Any] | None = None
@@ -306,7 +325,7 @@ class ExplorerView(w.VBox):
             if gen != self._generation:  # newer values came while drawing: the worker draws those next
                 self.counts["superseded"] += 1
                 return
-            self.figure.value = png
+            self.figure.value = figure_html(self.explorer, png, self._figure_width)
             self.text.value = f'<span style="font-family:monospace">{html.escape(result_text(res))}</span>'
             self.error.value = ""
             self.progress.layout.visibility = "hidden"
@@ -320,4 +339,4 @@ class ExplorerView(w.VBox):
         return f"ExplorerView({self.explorer.kernel_title or self.explorer.title!r})"
 
 
-__all__ = ["ExplorerView", "Superseded", "render_png", "result_text"]
+__all__ = ["ExplorerView", "Superseded", "figure_alt", "figure_html", "render_png", "result_text"]

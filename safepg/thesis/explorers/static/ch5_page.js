@@ -64,7 +64,7 @@ function safepgCh5TrajSeries(r, key, points, shift) {
 }
 function safepgCh5Live(root, spec, learnerSrc, page) {
   const inputs = root.querySelectorAll("[data-param]");
-  if (typeof safepgName === "function") inputs.forEach(safepgName);  // runtime.js: every control named
+  if (typeof safepgA11y === "function") safepgA11y(root, inputs);  // runtime.js: names, aria-live summary
   const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
   const data = spec.data;
   let url = null, worker = null, job = 0, st = null, pending = false, local = null;

@@ -132,6 +132,7 @@ function safepgLiveResult(p, st, data) {
 }
 function safepgLiveLearner(root, spec, learnerSrc) {
   const inputs = root.querySelectorAll("[data-param]");
+  if (typeof safepgA11y === "function") safepgA11y(root, inputs);  // runtime.js: names, aria-live summary
   const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
   const data = spec.data;
   let url = null, worker = null, job = 0, st = null, pending = false, local = null;
