@@ -38,7 +38,8 @@ test: setup browser-deps lint
 test-lib: setup
 	$(VPY) -m pytest tests -m "not browser"
 
-# MathJax from the npm registry into book/_vendor: pages render math offline.
+# MathJax from the npm registry into book/_vendor (pages render math offline), and axe-core into
+# _build/vendor for the accessibility test (never published).
 book-assets:
 	bash book/tools/vendor_assets.sh
 
