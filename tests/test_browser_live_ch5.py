@@ -7,6 +7,7 @@ The same explorers in the built book are checked by tests/test_browser_book.py."
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -197,3 +198,42 @@ def test_nothing_cut_off(browser, pages, name, width):
     pg.page.screenshot(path=str(SHOTS / f"live-{name}-{width}.png"), full_page=True)
     assert not pg.errors
 
+
+
+def _book_explorer_values(pg: OfflinePage, root: Any, after: int = 0) -> dict:
+    """The values of the explorer ``root`` on a book page once a run with a job above ``after`` is done."""
+    root.scroll_into_view_if_needed()
+    root.locator(".safepg-values").wait_for(state="attached", timeout=TIMEOUT_MS)
+    handle = root.element_handle()
+    pg.page.wait_for_function(
+        """([el, after]) => { const t = el.querySelector('.safepg-values').textContent;
+                              if (!t) return false; const v = JSON.parse(t);
+                              return v.job > after && v.result.values.done; }""",
+        arg=[handle, after], timeout=TIMEOUT_MS)
+    return json.loads(root.locator(".safepg-values").text_content())
+
+
+def test_book_lqg2d_page(browser, book):
+    """The 2-D chapter of the built book, from file://: both explorers run in a Web Worker and draw."""
+    pg = OfflinePage(browser, book / "book" / "lqg2d.html", width=1280, height=1400)
+    roots = pg.page.locator(".safepg-explorer:has(.safepg-status)")
+    assert roots.count() == 2
+    for i in range(2):
+        v = _book_explorer_values(pg, roots.nth(i))
+        assert v["result"]["values"]["worker"], "the run did not go to a Web Worker"
+        assert roots.nth(i).locator("svg path").count() > 0
+    assert not pg.errors and not pg.remote
+
+
+def test_book_cartpole_page(browser, book):
+    """The cart-pole chapter of the built book, from file://: the default run (the thesis's text)
+    leaves theta frozen and says so; the authors' preset moves theta_xdot."""
+    pg = OfflinePage(browser, book / "book" / "cartpole.html", width=1280, height=1400)
+    root = pg.page.locator(".safepg-explorer:has([data-preset])").first
+    v = _book_explorer_values(pg, root)
+    assert v["result"]["values"]["worker"] and v["result"]["values"]["adaptive"]["frozen"]
+    assert "theta did not move: " in v["result"]["text"]
+    root.get_by_role("button", name="the authors' settings").click()
+    authors = _book_explorer_values(pg, root, after=v["job"])["result"]["values"]["adaptive"]
+    assert authors["theta_moved"][1] > 1e-4 and not authors["frozen"]
+    assert not pg.errors and not pg.remote
