@@ -279,6 +279,8 @@
    * in the same order as the generic loop, so the same bits, about three times faster.
    */
   LqgBatch.prototype.run2 = function (theta, sigma, n, opt, src) {
+    if (opt.estimator !== "reinforce" && opt.baseline && opt.score !== "raw" && this.task.clip !== false)
+      return this.run2gb(theta, sigma, n, opt, src);
     const task = this.task, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
     const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
@@ -354,6 +356,84 @@
       }
     } else if (baseline) {
       for (let i = 0; i < 4 * n; i++) samples[i] -= acc[i];
+    }
+    return maxima ? [rmax, fmax] : null;
+  };
+
+  /**
+   * run2 for G(PO)MDP with baselines, clipped task, clipped-action score (the figures' runs):
+   * each trajectory's state, score, baseline and sample sums sit side by side in one array
+   * (ST = 16 doubles a trajectory), so a step reads and writes one block, with no branch on
+   * the options; the same operations in the same order as run2, so the same bits.
+   */
+  const ST = 16;  // x0 x1 | G0..G3 | baseline sums 0..3 | sample sums 0..3 | return | pad
+  LqgBatch.prototype.run2gb = function (theta, sigma, n, opt, src) {
+    const task = this.task, H = task.H;
+    this.grow(n);
+    if (!this.st || this.st.length < ST * this.cap) this.st = new Float64Array(ST * this.cap);
+    const st = this.st, s = this.s, z = this.z, samples = this.samples, returns = this.returns;
+    // The constants pass through a Float64Array so that the loop holds them as doubles: a matrix
+    // entry or bound that is an integer (1, 0, 2 from JSON) would otherwise be converted at each use.
+    const cf = this.cf || (this.cf = new Float64Array(24));
+    for (let i = 0; i < 4; i++) {
+      cf[i] = theta[i]; cf[4 + i] = task.A[i]; cf[8 + i] = task.B[i]; cf[12 + i] = task.Q[i]; cf[16 + i] = task.R[i];
+    }
+    cf[20] = task.stateBound; cf[21] = task.actionBound; cf[22] = sigma; cf[23] = task.gamma;
+    const k00 = cf[0], k01 = cf[1], k10 = cf[2], k11 = cf[3], a00 = cf[4], a01 = cf[5], a10 = cf[6], a11 = cf[7];
+    const b00 = cf[8], b01 = cf[9], b10 = cf[10], b11 = cf[11], q00 = cf[12], q01 = cf[13], q10 = cf[14], q11 = cf[15];
+    const r00 = cf[16], r01 = cf[17], r10 = cf[18], r11 = cf[19], bs = cf[20], ba = cf[21], sg = cf[22], gm = cf[23];
+    const nbs = -bs, nba = -ba;
+    const iv = 1.0 / (sg * sg), n2 = 2 * n, n3 = 3 * n, end = ST * n;
+    src.init(s, n, 2, -task.stateBound, task.stateBound);
+    st.fill(0, 0, end);
+    for (let j = 0, o = 0; j < n; j++, o += ST) { st[o] = s[j]; st[o + 1] = s[n + j]; }
+    let disc = 1.0, rmax = 0, fmax = 0;
+    const maxima = opt.constants === "batch";
+    // b_t - 1 (0 at t = 0) times the score before step t joins step t's pass, as in run2.
+    let b0 = 0, b1 = 0, b2 = 0, b3 = 0;
+    for (let t = 0; t < H; t++) {
+      src.step(z, n, 2, t, this.idx);
+      let n0 = 0, n1 = 0, nn2 = 0, nn3 = 0, d0 = 0, d1 = 0, d2 = 0, d3 = 0;
+      for (let o = 0, j = 0; o < end; o += ST, j++) {
+        const x0 = st[o], x1 = st[o + 1];
+        const h0 = st[o + 2], h1 = st[o + 3], h2 = st[o + 4], h3 = st[o + 5];
+        st[o + 6] += h0 * b0; st[o + 7] += h1 * b1; st[o + 8] += h2 * b2; st[o + 9] += h3 * b3;
+        const m0 = 0.0 + k00 * x0 + k01 * x1, m1 = 0.0 + k10 * x0 + k11 * x1;
+        const a0 = m0 + sg * z[j], a1 = m1 + sg * z[n + j];
+        const u0 = Math.min(Math.max(a0, nba), ba), u1 = Math.min(Math.max(a1, nba), ba);
+        let cost = 0.0 + (x0 * q00 * x0 + u0 * r00 * u0);
+        cost += x0 * q01 * x1 + u0 * r01 * u1;
+        cost += x1 * q10 * x0 + u1 * r10 * u0;
+        cost += x1 * q11 * x1 + u1 * r11 * u1;
+        const dr = -0.5 * cost * disc;
+        st[o + 14] += dr;
+        if (maxima) rmax = Math.max(rmax, Math.abs(-0.5 * cost), 0), fmax = Math.max(fmax, Math.abs(x0), Math.abs(x1));
+        const e0 = iv * (u0 - m0), e1 = iv * (u1 - m1);
+        const g0 = h0 + e0 * x0, g1 = h1 + e0 * x1, g2 = h2 + e1 * x0, g3 = h3 + e1 * x1;
+        st[o + 2] = g0; st[o + 3] = g1; st[o + 4] = g2; st[o + 5] = g3;
+        st[o + 10] += g0 * dr; st[o + 11] += g1 * dr; st[o + 12] += g2 * dr; st[o + 13] += g3 * dr;
+        const sq0 = g0 * g0, sq1 = g1 * g1, sq2 = g2 * g2, sq3 = g3 * g3;
+        n0 += sq0 * dr; n1 += sq1 * dr; nn2 += sq2 * dr; nn3 += sq3 * dr;
+        d0 += sq0; d1 += sq1; d2 += sq2; d3 += sq3;
+        const y0 = 0.0 + (a00 * x0 + b00 * u0) + (a01 * x1 + b01 * u1);
+        const y1 = 0.0 + (a10 * x0 + b10 * u0) + (a11 * x1 + b11 * u1);
+        st[o] = Math.min(Math.max(y0, nbs), bs);
+        st[o + 1] = Math.min(Math.max(y1, nbs), bs);
+      }
+      b0 = d0 !== 0 ? n0 / d0 : 0; b1 = d1 !== 0 ? n1 / d1 : 0;
+      b2 = d2 !== 0 ? nn2 / d2 : 0; b3 = d3 !== 0 ? nn3 / d3 : 0;
+      disc *= gm;
+    }
+    // The rows of run2's arrays: samples (sample sum - baseline sum, the last step's term added), G, acc.
+    const G = this.G, acc = this.acc;
+    for (let j = 0, o = 0; j < n; j++, o += ST) {
+      const c0 = st[o + 6] + st[o + 2] * b0, c1 = st[o + 7] + st[o + 3] * b1;
+      const c2 = st[o + 8] + st[o + 4] * b2, c3 = st[o + 9] + st[o + 5] * b3;
+      samples[j] = st[o + 10] - c0; samples[n + j] = st[o + 11] - c1;
+      samples[n2 + j] = st[o + 12] - c2; samples[n3 + j] = st[o + 13] - c3;
+      acc[j] = c0; acc[n + j] = c1; acc[n2 + j] = c2; acc[n3 + j] = c3;
+      G[j] = st[o + 2]; G[n + j] = st[o + 3]; G[n2 + j] = st[o + 4]; G[n3 + j] = st[o + 5];
+      returns[j] = st[o + 14]; s[j] = st[o]; s[n + j] = st[o + 1];
     }
     return maxima ? [rmax, fmax] : null;
   };
