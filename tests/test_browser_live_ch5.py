@@ -237,3 +237,16 @@ def test_book_cartpole_page(browser, book):
     authors = _book_explorer_values(pg, root, after=v["job"])["result"]["values"]["adaptive"]
     assert authors["theta_moved"][1] > 1e-4 and not authors["frozen"]
     assert not pg.errors and not pg.remote
+
+
+def test_book_cartpole_explorer_fits_a_phone(browser, book):
+    """At 390 px in the built chapter (whose start menu names the stored baseline, a long option),
+    no control of the cart-pole explorer runs past the page's width."""
+    pg = OfflinePage(browser, book / "book" / "cartpole.html", width=390, height=900)
+    root = pg.page.locator(".safepg-explorer:has([data-preset])").first
+    _book_explorer_values(pg, root)
+    cut = root.evaluate("""el => [...el.querySelectorAll('label, select, button, .safepg-text, .safepg-status')]
+        .filter(e => e.getBoundingClientRect().right > document.documentElement.clientWidth + 1)
+        .map(e => e.tagName + ': ' + e.textContent.slice(0, 60))""")
+    assert not cut, cut
+    assert not pg.errors and not pg.remote

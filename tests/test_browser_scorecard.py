@@ -216,7 +216,10 @@ def test_no_horizontal_overflow_and_a_visible_cue(browser, scorecard_page, width
         const doc = document.documentElement;
         const boxes = [...document.querySelectorAll('.sc-scroll')].map(b => {
             const r = b.getBoundingClientRect(), p = b.parentElement.getBoundingClientRect();
-            const hint = b.parentElement.querySelector('.sc-hint');
+            // The table's own hint, or the cue the book adds under any box that scrolls (safepg-book.js).
+            const hint = b.parentElement.querySelector('.sc-hint')
+                || (b.nextElementSibling && b.nextElementSibling.matches('.safepg-scroll-hint') ? b.nextElementSibling
+                    : null);
             const h = hint ? hint.getBoundingClientRect() : null;
             return {scrolls: b.scrollWidth > b.clientWidth + 1, overflowX: getComputedStyle(b).overflowX,
                     right: r.right, parentRight: p.right, hintVisible: !!h && h.width > 0 && h.height > 0};

@@ -60,7 +60,8 @@ function safepgPlot(svg, spec, res) {
   let x0 = Math.min(...pts.map(p => p[0])), x1 = Math.max(...pts.map(p => p[0]));
   let y0 = spec.ymin != null ? ty(spec.ymin) : Math.min(...pts.map(p => p[1]));
   let y1 = spec.ymax != null ? ty(spec.ymax) : Math.max(...pts.map(p => p[1]));
-  if (x1 === x0) x1 = x0 + 1; if (y1 === y0) y1 = y0 + 1;
+  // A constant series sits in the middle of a unit range (a decade on a log axis), not on its edge.
+  if (x1 === x0) x1 = x0 + 1; if (y1 === y0) { y0 -= 0.5; y1 += 0.5; }
   const pad = 0.05 * (y1 - y0); y0 -= pad; y1 += pad;
   const X = v => m.l + (tx(v) - x0) / (x1 - x0) * (W - m.l - m.r);
   const Y = v => Hh - m.b - (Math.min(Math.max(ty(v), y0), y1) - y0) / (y1 - y0) * (Hh - m.t - m.b);
