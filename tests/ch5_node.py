@@ -26,7 +26,7 @@ process.stdout.write(JSON.stringify(out));
 
 def run_page(script: str, obj: str, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces", "linked"}``."""
-    src = static_text("ch5_page.js") + "\n" + static_text(script)
+    src = static_text("live_jobs.js") + "\n" + static_text("ch5_page.js") + "\n" + static_text(script)
     proc = subprocess.run([NODE, "-e", _SCRIPT], input=json.dumps({"src": src, "object": obj, "cases": cases}),
                           capture_output=True, text=True, timeout=120, check=False)
     if proc.returncode:

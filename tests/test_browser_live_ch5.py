@@ -250,3 +250,30 @@ def test_book_cartpole_explorer_fits_a_phone(browser, book):
         .map(e => e.tagName + ': ' + e.textContent.slice(0, 60))""")
     assert not cut, cut
     assert not pg.errors and not pg.remote
+
+
+@pytest.mark.parametrize("name", ["steps", "cartpole"])
+def test_runs_on_the_page_thread_without_workers(browser, pages, name):
+    """A browser without Web Workers (static/live_jobs.js's fallback): the runs go to slices of
+    the page's thread, finish and draw, and a moved control still replaces the run."""
+    path, _ = pages[name]
+    page = browser.new_page(viewport={"width": 1280, "height": 1400})
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.add_init_script("delete window.Worker;")
+    try:
+        page.goto(path.as_uri())
+        done = """after => { const t = document.querySelector('.safepg-values').textContent;
+                             if (!t) return false; const v = JSON.parse(t);
+                             return v.job > after && v.result.values.done; }"""
+        page.wait_for_function(done, arg=0, timeout=TIMEOUT_MS)
+        first = json.loads(page.locator(".safepg-values").text_content())
+        assert first["result"]["values"]["worker"] is False and not first["result"]["values"].get("error")
+        assert "page thread" in page.locator(".safepg-status").text_content()
+        page.locator('[data-param="seed"]').fill("3")
+        page.wait_for_function(done, arg=first["job"], timeout=TIMEOUT_MS)
+        second = json.loads(page.locator(".safepg-values").text_content())
+        assert second["params"]["seed"] == 3 and second["result"]["text"] != first["result"]["text"]
+        assert not errors, errors
+    finally:
+        page.close()

@@ -52,7 +52,8 @@ from safepg.thesis.explorers.live_learner import (
 NODE = shutil.which("node")
 # Node requires it by path: the learner as the page loads it, its files concatenated.
 STATIC = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
-PAGE = STATIC.with_name("live_page.js")
+#: The page half as the page loads it: the runs' worker and thinning (live_jobs.js), then live_page.js.
+PAGE = [str(STATIC.with_name("live_jobs.js")), str(STATIC.with_name("live_page.js"))]
 LEARNER = Path(tempfile.mkdtemp()) / "learner_all.js"
 LEARNER.write_text(learner_js())
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
@@ -128,7 +129,7 @@ if (req.page) {
   // The page half (static/live_page.js) on whole records: safepg's (rec) or the JavaScript learner's (cfg).
   const vm = require("vm"), ctx = {};
   vm.createContext(ctx);
-  vm.runInContext(fs.readFileSync(req.page.src, "utf8"), ctx);
+  for (const src of req.page.src) vm.runInContext(fs.readFileSync(src, "utf8"), ctx);
   out.page = req.page.cases.map(q => {
     const runs = {};
     for (const [name, r] of Object.entries(q.runs)) {
@@ -359,7 +360,7 @@ def test_page_summary_and_text_match_the_kernel_twin():
     cases = [page_params(**FROZEN), page_params(), page_params(bound="chebyshev", vanilla_alpha="1e-6"),
              page_params(bound="hoeffding", budget="100000", vanilla_n="100")]
     recs = [python_runs(p) for p in cases]
-    got = run_node({"page": {"src": str(PAGE), "data": data, "cases": [
+    got = run_node({"page": {"src": PAGE, "data": data, "cases": [
         {"p": p, "runs": {k: {"rec": as_page_record(r)} for k, r in rs.items()}} for p, rs in zip(cases, recs)]}})
     flags = []
     for p, rs, js in zip(cases, recs, got["page"]):
@@ -393,7 +394,7 @@ def test_page_flags_a_frozen_run_of_its_own_learner():
                 "budget": int(p["budget"]), "seed": 0, "theta0": 0, "bound": p["bound"].replace("-er", ""),
                 "delta": p["delta"], "empiricalRange": p["bound"].endswith("-er")}
 
-    got = run_node({"page": {"src": str(PAGE), "data": data, "cases": [
+    got = run_node({"page": {"src": PAGE, "data": data, "cases": [
         {"p": p, "runs": {"adaptive": {"cfg": cfg(p)}}} for p in (frozen, moving)]}, "task": task_data()})["page"]
     f, m = (g["text"].split("<br>")[0] for g in got)
     assert got[0]["values"]["adaptive"]["theta_moved"] == 0 and got[0]["values"]["adaptive"]["ratio_vacuous"]

@@ -60,7 +60,7 @@ def finite(v: Any) -> float | None:
 
 def thin(n: int, points: int = CURVE_POINTS) -> list[int]:
     """Indices of at most ``points`` evenly spread entries of a length-n curve (first and last
-    kept): the page's ``safepgCh5Thin``."""
+    kept): the page's ``safepgThin`` (``static/live_jobs.js``)."""
     if n <= points:
         return list(range(n))
     out: list[int] = []
@@ -199,7 +199,8 @@ class Ch5LiveExplorer(Explorer):
             '<div class="safepg-status" role="status" style="font-size:0.85em;opacity:0.8;margin:0.2em 0"></div>'
             f'{self._plots_html()}<div class="safepg-text" style="font-family:monospace;font-size:0.9em;'
             'overflow-wrap:anywhere"></div><pre class="safepg-values" hidden></pre>'
-            f'<script>(function(){{\n{static_text("runtime.js")}\n{static_text("ch5_page.js")}\n{page}\n'
+            f'<script>(function(){{\n{static_text("runtime.js")}\n{static_text("live_jobs.js")}\n'
+            f'{static_text("ch5_page.js")}\n{page}\n'
             f"const spec={spec};const learnerSrc={learner};"
             f'safepgCh5Live(document.getElementById("{uid}"),spec,learnerSrc,{self.page_object});}})();</script></div>'
         )

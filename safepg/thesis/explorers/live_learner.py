@@ -165,8 +165,10 @@ class LiveLearnerExplorer(Explorer):
             f'{self._plots_html()}<div class="safepg-text" style="font-family:monospace;font-size:0.9em"></div>'
             '<pre class="safepg-values" hidden></pre>'
             # The page half (static/live_page.js) draws with the runtime's safepgPlot; the learner
-            # travels as a string so the worker can be built from a Blob (no file, no network).
-            f'<script>(function(){{\n{static_text("runtime.js")}\n{static_text("live_page.js")}'
+            # travels as a string so the worker can be built from a Blob (no file, no network:
+            # static/live_jobs.js).
+            f'<script>(function(){{\n{static_text("runtime.js")}\n{static_text("live_jobs.js")}\n'
+            f'{static_text("live_page.js")}'
             f"const spec={spec};const learnerSrc={learner};"
             f'safepgLiveLearner(document.getElementById("{uid}"),spec,learnerSrc);}})();</script></div>'
         )

@@ -2,31 +2,6 @@
 // in a Web Worker built from an inline Blob; each run is kept as a trace; the explorer's own
 // object (safepgLqg2dSteps, safepgLqg2dAdaptive, safepgCartpolePage) says which runs a setting
 // makes (configs) and what to draw from the traces (result), as its Python twin does.
-const SAFEPG_CH5_GLUE = `
-self.onmessage = function (e) {
-  const msg = e.data;
-  try {
-    const driver = new safepgLearner.Driver(msg);
-    let first = true;
-    while (!driver.done) {
-      const parts = driver.advance(first ? 15 : msg.every);
-      first = false;
-      self.postMessage({type: driver.done ? "done" : "progress", job: msg.job, parts: parts});
-    }
-  } catch (err) {
-    self.postMessage({type: "error", job: msg.job, message: String((err && err.message) || err)});
-  }
-};`;
-function safepgCh5Thin(n, points) {
-  // ch5_live.thin: at most `points` evenly spread indices, first and last kept.
-  if (n <= points) { const o = []; for (let i = 0; i < n; i++) o.push(i); return o; }
-  const o = [];
-  for (let i = 0; i < points; i++) {
-    const k = Math.floor(i * (n - 1) / (points - 1) + 0.5);
-    if (!o.length || o[o.length - 1] !== k) o.push(k);
-  }
-  return o;
-}
 function safepgCh5Num(v) { return (v === null || v === undefined || !isFinite(v)) ? null : +v; }
 function safepgCh5Fixed(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d); }
 function safepgCh5Exp(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toExponential(d); }
@@ -51,7 +26,7 @@ function safepgCh5Summary(r) {
 }
 function safepgCh5IterSeries(r, key, points, index, perUpdate) {
   // ch5_live.iteration_series.
-  const ys = r[key], keep = safepgCh5Thin(ys.length, points);
+  const ys = r[key], keep = safepgThin(ys.length, points);
   return [keep.map(k => perUpdate ? k : k + 1), keep.map(k => index === undefined || index === null ? ys[k] : ys[k][index])];
 }
 function safepgCh5TrajSeries(r, key, points, shift) {
@@ -59,7 +34,7 @@ function safepgCh5TrajSeries(r, key, points, shift) {
   const ends = [];
   let tot = 0;
   for (const k of r.batchSize) { tot += k; ends.push(tot); }
-  const keep = safepgCh5Thin(ends.length, points);
+  const keep = safepgThin(ends.length, points);
   return [keep.map(k => ends[k]), keep.map(k => r[key][k + (shift || 0)])];
 }
 function safepgCh5Live(root, spec, learnerSrc, page) {
@@ -67,9 +42,8 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
   if (typeof safepgA11y === "function") safepgA11y(root, inputs);  // runtime.js: names, aria-live summary
   const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
   const data = spec.data;
-  let url = null, worker = null, job = 0, st = null, pending = false, local = null;
-  try { url = URL.createObjectURL(new Blob([learnerSrc, SAFEPG_CH5_GLUE], {type: "text/javascript"})); }
-  catch (e) { url = null; }
+  let job = 0, st = null, pending = false;
+  const jobs = new SafepgJobs(learnerSrc, receive);  // live_jobs.js
   function params() {
     const p = {};
     inputs.forEach(inp => { p[inp.dataset.param] = safepgParam(inp); });
@@ -112,26 +86,12 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
       r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms;
     }
     st.elapsed = performance.now() - st.t0;
-    if (msg.type === "done") { st.done = true; if (worker) { worker.terminate(); worker = null; } }
+    if (msg.type === "done") st.done = true;
     schedule();
   }
-  function runLocally(msg) {
-    // No Web Worker (a browser that refuses Blob workers): slices of the page's own thread.
-    const L = new Function(learnerSrc + "\nreturn safepgLearner;")();
-    const driver = new L.Driver(msg), mine = msg.job;
-    local = mine;
-    (function slice() {
-      if (local !== mine) return;  // cancelled by a newer run
-      let parts;
-      try { parts = driver.advance(25); }
-      catch (err) { receive({type: "error", job: mine, message: String((err && err.message) || err)}); return; }
-      receive({type: driver.done ? "done" : "progress", job: mine, parts: parts});
-      if (!driver.done) setTimeout(slice, 0);
-    })();
-  }
   function start() {
-    job += 1; local = null;
-    if (worker) { worker.terminate(); worker = null; }  // cancel the run in flight
+    job += 1;
+    jobs.stop();  // cancel the run in flight, also when the new settings cannot run
     const p = params();
     inputs.forEach(inp => {
       const out = root.querySelector(`[data-show="${inp.dataset.param}"]`);
@@ -151,20 +111,8 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
     const msg = {job: job, task: made.task, every: 150, runs: made.runs};
     st = {job: job, p: p, cfgs: cfgs, total: total, runs: {}, done: false, elapsed: 0, t0: performance.now(),
           worker: false, error: null};
-    if (url && typeof Worker !== "undefined") {
-      try {
-        worker = new Worker(url);
-        worker.onmessage = e => receive(e.data);
-        worker.onerror = e => {  // a browser that refuses Blob workers: run in the page instead
-          e.preventDefault();
-          if (worker) worker.terminate();
-          worker = null; st.worker = false;
-          runLocally(msg);
-        };
-        worker.postMessage(msg);
-        st.worker = true;
-      } catch (e) { worker = null; runLocally(msg); }
-    } else runLocally(msg);
+    const mine = st;
+    st.worker = jobs.start(msg, () => { mine.worker = false; });
     draw();
   }
   function set(name, value) {

@@ -1,27 +1,3 @@
-const SAFEPG_WORKER_GLUE = `
-self.onmessage = function (e) {
-  const msg = e.data;
-  try {
-    const driver = new safepgLearner.Driver(msg);
-    let first = true;
-    while (!driver.done) {
-      const parts = driver.advance(first ? 15 : msg.every);
-      first = false;
-      self.postMessage({type: driver.done ? "done" : "progress", job: msg.job, parts: parts});
-    }
-  } catch (err) {
-    self.postMessage({type: "error", job: msg.job, message: String((err && err.message) || err)});
-  }
-};`;
-function safepgLiveThin(n, points) {
-  if (n <= points) { const o = []; for (let i = 0; i < n; i++) o.push(i); return o; }
-  const o = [];
-  for (let i = 0; i < points; i++) {
-    const k = Math.floor(i * (n - 1) / (points - 1) + 0.5);
-    if (!o.length || o[o.length - 1] !== k) o.push(k);
-  }
-  return o;
-}
 function safepgLiveSummary(r, tol) {
   // safepg.learning.LearningRecord's summary of a (possibly partial) record, with how far
   // theta moved (live_learner.theta_moved) and whether that is under tol (the ratio is vacuous).
@@ -111,7 +87,7 @@ function safepgLiveResult(p, st, data) {
                                       : {color: data.vanilla_color, dash: false};
     const label = name === "adaptive" ? "Algorithm 4.1 (live)"
                                       : `vanilla, N = ${p.vanilla_n}, alpha = ${p.vanilla_alpha}`;
-    const keep = safepgLiveThin(I, data.points);
+    const keep = safepgThin(I, data.points);
     plots.N.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.batchSize[i]), ...style});
     plots.alpha.series.push({label: label, x: keep.map(i => i + 1), y: keep.map(i => r.alpha[i]), ...style});
     // J of the policy that generated trajectory T (Figures 5.1-5.2), on a grid of T.
@@ -135,9 +111,8 @@ function safepgLiveLearner(root, spec, learnerSrc) {
   if (typeof safepgA11y === "function") safepgA11y(root, inputs);  // runtime.js: names, aria-live summary
   const valuesEl = root.querySelector(".safepg-values"), statusEl = root.querySelector(".safepg-status");
   const data = spec.data;
-  let url = null, worker = null, job = 0, st = null, pending = false, local = null;
-  try { url = URL.createObjectURL(new Blob([learnerSrc, SAFEPG_WORKER_GLUE], {type: "text/javascript"})); }
-  catch (e) { url = null; }
+  let job = 0, st = null, pending = false;
+  const jobs = new SafepgJobs(learnerSrc, receive);  // live_jobs.js
   function params() {
     const p = {};
     inputs.forEach(inp => { p[inp.dataset.param] = inp.tagName === "SELECT" ? inp.value : parseFloat(inp.value); });
@@ -180,24 +155,11 @@ function safepgLiveLearner(root, spec, learnerSrc) {
       r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms;
     }
     st.elapsed = performance.now() - st.t0;
-    if (msg.type === "done") { st.done = true; if (worker) { worker.terminate(); worker = null; } }
+    if (msg.type === "done") st.done = true;
     schedule();
   }
-  function runLocally(msg) {
-    // No Web Worker (a browser that refuses Blob workers): slices of the page's own thread.
-    const L = new Function(learnerSrc + "\nreturn safepgLearner;")();
-    const driver = new L.Driver(msg), mine = msg.job;
-    local = mine;
-    (function slice() {
-      if (local !== mine) return;  // cancelled by a newer run
-      const parts = driver.advance(25);
-      receive({type: driver.done ? "done" : "progress", job: mine, parts: parts});
-      if (!driver.done) setTimeout(slice, 0);
-    })();
-  }
   function start() {
-    job += 1; local = null;
-    if (worker) { worker.terminate(); worker = null; }  // cancel the run in flight
+    job += 1;
     const p = params();
     inputs.forEach(inp => {
       const out = root.querySelector(`[data-show="${inp.dataset.param}"]`);
@@ -205,20 +167,8 @@ function safepgLiveLearner(root, spec, learnerSrc) {
     });
     const msg = {job: job, task: data.task, every: 150, runs: configs(p)};
     st = {job: job, p: p, runs: {}, done: false, elapsed: 0, t0: performance.now(), worker: false, error: null};
-    if (url && typeof Worker !== "undefined") {
-      try {
-        worker = new Worker(url);
-        worker.onmessage = e => receive(e.data);
-        worker.onerror = e => {  // a browser that refuses Blob workers: run in the page instead
-          e.preventDefault();
-          if (worker) worker.terminate();
-          worker = null; st.worker = false;
-          runLocally(msg);
-        };
-        worker.postMessage(msg);
-        st.worker = true;
-      } catch (e) { worker = null; runLocally(msg); }
-    } else runLocally(msg);
+    const mine = st;
+    st.worker = jobs.start(msg, () => { mine.worker = false; });  // cancels the run in flight
     draw();
   }
   inputs.forEach(inp => inp.addEventListener("input", start));
