@@ -169,6 +169,25 @@
    * Workspace of the vector LQG's batches, rows of length cap (component-major, so each
    * gradient component's samples are one contiguous row for the bounds).
    */
+  /**
+   * REINFORCE's gradient samples from the scores' sums G (M rows of n) and the returns, with the
+   * variance-minimising baseline of each component when `baseline` (b_p = sum G^2 R / sum G^2).
+   */
+  function reinforceSamples(G, returns, samples, n, M, baseline) {
+    for (let p = 0; p < M; p++) {
+      const o = p * n;
+      let nb = 0.0, db = 0.0;
+      for (let j = 0; j < n; j++) {
+        const g = G[o + j], sq = g * g;
+        nb += sq * returns[j]; db += sq;
+        samples[o + j] = g * returns[j];
+      }
+      if (baseline) {
+        const bp = db !== 0 ? nb / db : 0;
+        for (let j = 0; j < n; j++) samples[o + j] -= G[o + j] * bp;
+      }
+    }
+  }
   function LqgBatch(task) {
     this.task = task; this.m = task.dim; this.M = task.dim * task.dim; this.cap = 0;
     this.num = new Float64Array(task.H * this.M); this.den = new Float64Array(task.H * this.M);
@@ -255,19 +274,7 @@
       disc *= gamma;
     }
     if (reinforce) {
-      for (let p = 0; p < M; p++) {
-        const o = p * n;
-        let nb = 0.0, db = 0.0;
-        for (let j = 0; j < n; j++) {
-          const g = G[o + j], sq = g * g;
-          nb += sq * returns[j]; db += sq;
-          samples[o + j] = g * returns[j];
-        }
-        if (baseline) {
-          const bp = db !== 0 ? nb / db : 0;
-          for (let j = 0; j < n; j++) samples[o + j] -= G[o + j] * bp;
-        }
-      }
+      reinforceSamples(G, returns, samples, n, M, baseline);
     } else if (baseline) {
       for (let i = 0; i < M * n; i++) samples[i] -= acc[i];
     }
@@ -341,19 +348,7 @@
       }
     }
     if (reinforce) {
-      for (let p = 0; p < 4; p++) {
-        const o = p * n;
-        let nb = 0.0, db = 0.0;
-        for (let j = 0; j < n; j++) {
-          const g = G[o + j], sq = g * g;
-          nb += sq * returns[j]; db += sq;
-          samples[o + j] = g * returns[j];
-        }
-        if (baseline) {
-          const bp = db !== 0 ? nb / db : 0;
-          for (let j = 0; j < n; j++) samples[o + j] -= G[o + j] * bp;
-        }
-      }
+      reinforceSamples(G, returns, samples, n, 4, baseline);
     } else if (baseline) {
       for (let i = 0; i < 4 * n; i++) samples[i] -= acc[i];
     }
