@@ -50,7 +50,7 @@ const safepgCartpolePage = {
       s.c_min = cs.length ? Math.min(...cs) : null; s.c_max = cs.length ? Math.max(...cs) : null;
       values[name] = s;
       const head = `${label}: ${s.iterations} iterations, ${s.trajectories} trajectories, mean batch return ` +
-        `${safepgCh5Fixed(s.upsilon_bar, 2)}`;
+        `${safepgFixed(s.upsilon_bar, 2)}`;
       let tail;
       if (name === "adaptive") {
         const t0 = r.theta[0];

@@ -3,7 +3,6 @@
 // object (safepgLqg2dSteps, safepgLqg2dAdaptive, safepgCartpolePage) says which runs a setting
 // makes (configs) and what to draw from the traces (result), as its Python twin does.
 function safepgCh5Num(v) { return (v === null || v === undefined || !isFinite(v)) ? null : +v; }
-function safepgCh5Fixed(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d); }
 function safepgCh5Exp(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toExponential(d); }
 function safepgCh5Summary(r) {
   // ch5_live.trace_summary.

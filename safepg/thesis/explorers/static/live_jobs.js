@@ -1,4 +1,5 @@
-// The live learners' runs (live_page.js, ch5_page.js). A job runs the learner's Driver (passed
+// What the live learners' pages share (live_page.js, ch5_page.js): their runs, thinning and
+// number format. A job runs the learner's Driver (passed
 // as source, so the worker is built from an inline Blob: no file, no network, file:// works) in
 // a Web Worker; starting a job terminates the one in flight, whose late messages the page drops
 // by job number. A browser that refuses Blob workers runs the job in slices of the page's thread.
@@ -26,6 +27,10 @@ function safepgThin(n, points) {
     if (!o.length || o[o.length - 1] !== k) o.push(k);
   }
   return o;
+}
+function safepgFixed(v, d) {
+  // A number with d decimals for the summary lines; "-" for none (null, NaN, infinite).
+  return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d);
 }
 function SafepgJobs(learnerSrc, receive) {
   // receive(msg): {type: "progress" | "done" | "error", job, parts | message}.

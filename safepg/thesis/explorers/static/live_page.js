@@ -23,18 +23,17 @@ function safepgLiveSummary(r, tol) {
           J_final: r.J[I], theta_final: r.theta[I], theta_moved: moved, ratio_vacuous: I === 0 || moved < tol,
           J_at: Jat, first_batches: r.batchSize.slice(0, 3), done: r.done, diverged: r.diverged};
 }
-function safepgLiveFixed(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "-" : v.toFixed(d); }
 function safepgLiveLine(name, v, data) {
   // One run's summary line: live_learner.run_line, word for word.
   const m = v.theta_moved;
   const moved = !isFinite(m) ? "-" : m === 0 ? "0" : m < 1e-3 ? m.toExponential(1) : m.toFixed(4);
   const ratio = v.ratio_vacuous
     ? `theta moved by ${moved}, less than ${100 * data.still}% of the way to theta* = ` +
-      `${safepgLiveFixed(data.theta_star, 2)}: the improvement ratio carries no information`
-    : `theta moved by ${moved}, improvement ratio ${safepgLiveFixed(100 * v.improvement_ratio, 2)}%`;
+      `${safepgFixed(data.theta_star, 2)}: the improvement ratio carries no information`
+    : `theta moved by ${moved}, improvement ratio ${safepgFixed(100 * v.improvement_ratio, 2)}%`;
   return `${name}: ${v.iterations} iterations, ${v.trajectories} trajectories, ` +
-    `Upsilon-bar ${safepgLiveFixed(v.upsilon_bar, 4)}, J ${safepgLiveFixed(v.J_final, 3)} at theta ` +
-    `${safepgLiveFixed(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}; ${ratio}.`;
+    `Upsilon-bar ${safepgFixed(v.upsilon_bar, 4)}, J ${safepgFixed(v.J_final, 3)} at theta ` +
+    `${safepgFixed(v.theta_final, 4)}${v.diverged ? " (diverged)" : ""}; ${ratio}.`;
 }
 function safepgLiveObjectives(data) {
   // Which objective each number is on: live_learner.objectives_line.
@@ -51,7 +50,7 @@ function safepgLiveText(values, data, B) {
   if (values.vanilla) lines.push(safepgLiveLine("vanilla PG", values.vanilla, data));
   lines.push(values.thesis.found
     ? `stored safepg run ${values.thesis.name} (seed mean, first ${B} trajectories): ` +
-      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${safepgLiveFixed(values.thesis.upsilon_bar, 4)}.`
+      `${values.thesis.iterations.toFixed(0)} iterations, Upsilon-bar ${safepgFixed(values.thesis.upsilon_bar, 4)}.`
     : "no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, " +
       "delta in {0.05, 0.25, 0.5, 0.75, 0.95}).");
   lines.push(safepgLiveObjectives(data));

@@ -34,9 +34,9 @@ const safepgLqg2dSteps = {
       const s = values[step] = safepgCh5Summary(r), th = s.theta_final;
       const ratio = s.improvement_ratio === null ? null : 100 * s.improvement_ratio;
       lines.push(`${label}: ${s.iterations} iterations, ${s.trajectories} trajectories, J ` +
-        `${safepgCh5Fixed(s.J_final, 3)} at theta_11 ${safepgCh5Fixed(th[data.theta_index[0]], 6)}, theta_22 ` +
-        `${safepgCh5Fixed(th[data.theta_index[1]], 6)}${s.diverged ? " (diverged)" : ""}; improvement ` +
-        `ratio ${safepgCh5Fixed(ratio, 2)}%.`);
+        `${safepgFixed(s.J_final, 3)} at theta_11 ${safepgFixed(th[data.theta_index[0]], 6)}, theta_22 ` +
+        `${safepgFixed(th[data.theta_index[1]], 6)}${s.diverged ? " (diverged)" : ""}; improvement ` +
+        `ratio ${safepgFixed(ratio, 2)}%.`);
     }
     lines.push(data.printed);
     return {plots: plots, values: values, text: lines.join("<br>")};
@@ -75,8 +75,8 @@ const safepgLqg2dAdaptive = {
       const s = values[name] = safepgCh5Summary(r);
       const ratio = s.improvement_ratio === null ? null : 100 * s.improvement_ratio;
       lines.push(`${label}: ${s.iterations} iterations, ${s.trajectories} trajectories, Upsilon-bar ` +
-        `${safepgCh5Fixed(s.upsilon_bar, 2)}, J ${safepgCh5Fixed(s.J_final, 3)}` +
-        `${s.diverged ? " (diverged)" : ""}; improvement ratio ${safepgCh5Fixed(ratio, 2)}%.`);
+        `${safepgFixed(s.upsilon_bar, 2)}, J ${safepgFixed(s.J_final, 3)}` +
+        `${s.diverged ? " (diverged)" : ""}; improvement ratio ${safepgFixed(ratio, 2)}%.`);
     }
     lines.push(data.printed);
     return {plots: plots, values: values, text: lines.join("<br>")};
