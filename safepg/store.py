@@ -9,7 +9,7 @@ loss) leaves that temporary file behind, named after its host and process id, so
 writers may therefore share a folder.
 
 A run file that exists but cannot be read as a record (empty, truncated, overwritten,
-arrays that do not fit together: :class:`~safepg.record.RecordFileError`) is *damaged*.
+arrays that do not fit together: :class:`!safepg.record.RecordFileError`) is *damaged*.
 A damaged file is never deleted: the readers leave it out with a warning, and a runner
 about to compute its run again sets it aside first (:func:`set_aside`), keeping it for
 inspection. A readable file of other settings or another ``RESULTS_VERSION`` is not
@@ -56,7 +56,7 @@ class DamagedRunWarning(UserWarning):
 class DamagedRunsError(Exception):
     """Run files that exist but cannot be read.
 
-    ``damaged`` lists them, one :class:`~safepg.record.RecordFileError` (``path``,
+    ``damaged`` lists them, one :class:`!safepg.record.RecordFileError` (``path``,
     ``reason``) per file.
     """
 
@@ -75,7 +75,7 @@ def load_stored(path: Path, key: str, on_damaged: OnDamaged = "warn") -> Learnin
 
     Returns ``None`` when the file is missing, holds an interrupted run, or is stale: made
     by other settings or another library version (which is part of the key). A damaged
-    file (:class:`~safepg.record.RecordFileError`) is handled as ``on_damaged`` says
+    file (:class:`!safepg.record.RecordFileError`) is handled as ``on_damaged`` says
     (:data:`OnDamaged`); unless that raises, it counts as missing. A file that cannot be
     opened at all (no permission) raises ``OSError``: that says nothing about its contents.
     """

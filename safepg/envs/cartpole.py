@@ -415,7 +415,7 @@ class CartPole:
         n : int
             Number of trajectories (>= 1).
         rng : Generator, int or None
-            Random source (see :func:`safepg.rng.as_generator`).
+            Random source (see :func:`!safepg.rng.as_generator`).
 
         Returns
         -------
@@ -490,7 +490,7 @@ class CartPole:
         ``gradient_samples(policy, simulate(...), estimator, baseline, score_action)`` and
         ``undiscounted_returns(simulate(...))`` up to rounding, without materialising the
         trajectories: each episode is followed only until it terminates (see
-        :mod:`safepg.envs._cartpole_kernel`). The result does not depend on the number of
+        :mod:`!safepg.envs._cartpole_kernel`). The result does not depend on the number of
         numba threads.
 
         Parameters
@@ -500,7 +500,7 @@ class CartPole:
         n : int
             Number of trajectories (>= 1).
         rng : Generator, int or None
-            Random source (see :func:`safepg.rng.as_generator`).
+            Random source (see :func:`!safepg.rng.as_generator`).
         estimator : {"gpomdp", "reinforce"}
             Likelihood-ratio estimator (discounted with ``gamma``).
         baseline : bool

@@ -74,7 +74,7 @@ class GymTask:
     r"""A gymnasium environment (``Box`` observations and actions) as a safe-PG task.
 
     ``simulate(policy, n, rng)`` runs n episodes of horizon H at once in a
-    :class:`gymnasium.vector.SyncVectorEnv` (one vectorised ``step`` over all n
+    :class:`!gymnasium.vector.SyncVectorEnv` (one vectorised ``step`` over all n
     environments per time step) with the linear Gaussian policy
 
     .. math:: a_t \sim \mathcal N\big(K\phi(o_t), \Sigma\big), \qquad
@@ -117,7 +117,7 @@ class GymTask:
         A-bar, a bound on |u_i| (Lemma 4.3.3); default max(|low|, |high|) when bounded.
     features : callable, optional
         Vectorised feature map phi: observations (N, d_obs) float64 -> features
-        (N, d_phi). Default: the flattened observation. See :func:`with_bias`.
+        (N, d_phi). Default: the flattened observation. See :func:`!safepg.envs.gym_task.with_bias`.
     horizon_term : {"effective", "truncated", "horizon"}
         The horizon factor of the penalty constant (see
         :class:`~safepg.constants.TaskConstants`).
@@ -154,10 +154,10 @@ class GymTask:
     the same Generator state gives the same batch.
 
     Unlike the thesis's tasks (:class:`~safepg.envs.LQG`, the cart-pole), whose
-    arithmetic is pinned down by :mod:`safepg.portable`, the numbers here are not
+    arithmetic is pinned down by :mod:`!safepg.portable`, the numbers here are not
     guaranteed bit-identical across CPUs: gymnasium's dynamics use NumPy and libm
     (``sin``, ``cos``, ...), whose last bits may differ. On one machine a seed still
-    reproduces the batch exactly. The thesis layer (:mod:`safepg.thesis`) does not use
+    reproduces the batch exactly. The thesis layer (:mod:`!safepg.thesis`) does not use
     this class.
 
     The task has no closed-form J, so ``LearningRecord.J`` is NaN; ``J_hat`` holds the

@@ -129,7 +129,7 @@ class LQG:
         """Simulate ``n`` trajectories of length H at once.
 
         Trajectory i reads stream i of one batch key drawn from ``rng``
-        (:mod:`safepg.streams`): its initial state, then its standard normals step by
+        (:mod:`!safepg.streams`): its initial state, then its standard normals step by
         step. A seed fixes the batch bit for bit, and :meth:`gradient_batch` sees the same one.
         """
         self._check_policy(policy)
@@ -331,7 +331,7 @@ class LQG:
 
         Same random numbers as :meth:`simulate` (one batch key from ``rng``), and the same numbers
         as ``gradient_samples(policy, simulate(...), ...)`` up to rounding, without
-        materialising the trajectories (see :mod:`safepg.envs._lqg_kernel`).
+        materialising the trajectories (see :mod:`!safepg.envs._lqg_kernel`).
         """
         from safepg.envs import _lqg_kernel as kernels
 

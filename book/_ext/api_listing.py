@@ -1,0 +1,311 @@
+"""Generate the API reference page's sections from the modules it names.
+
+``book/api.md`` holds one fenced block ``{safepg-api}`` with a module name per line. Before
+the page is parsed, this extension replaces the block with, for each module: a heading, the
+first line of the module's docstring, an autosummary table of the module's public names and
+the full autodoc entry of each. The names are read from the module itself (its ``__all__``,
+else the public names its source defines at top level), so a name added to a module appears
+on the page without editing it, and a module is added with one line.
+
+An object that an earlier section already documents in full (``safepg.LQG`` is
+``safepg.envs.LQG``) gets a one-line entry pointing there, which keeps the page short and
+still gives the table's link a target.
+
+Docstrings cite objects by the path of the module that defines them
+(``safepg.envs.lqg.LQG.thesis_1d``) or by a name their module imports (``adaptive_pg`` in
+:mod:`safepg.runner`), where the page documents them under the name users import
+(``safepg.LQG.thesis_1d``, ``safepg.adaptive_pg``). A reference Sphinx cannot resolve is
+imported here, and when it is an object the page documents, it links there; anything else
+stays a missing reference (an error under ``-n -W``).
+
+The docstrings write an absolute value as in plain text, ``|r_t|``, which is how ``help()``
+shows them; to reStructuredText that is a substitution reference, an error when none is
+defined. Outside inline markup, such a ``|...|`` is shown here as the literal text it is.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import re
+from pathlib import Path
+from typing import Any
+
+#: The book's tables do not wrap (safepg-book.css keeps numbers on one line); an autosummary
+#: table's summaries must, and its names must not be broken letter by letter.
+STYLE = """```{raw} html
+<style>
+.bd-article table.autosummary td { white-space: normal; }
+.bd-article table.autosummary td:first-child, .bd-article table.autosummary td:first-child * {
+  white-space: nowrap; overflow-wrap: normal; word-break: normal; }
+</style>
+```
+"""
+
+#: The fenced block that lists the modules: ```{safepg-api} ... ```, a module per line.
+BLOCK = re.compile(r"^```\{safepg-api\}[ \t]*\n(?P<body>.*?)^```[ \t]*$", re.MULTILINE | re.DOTALL)
+
+
+def block_modules(text: str) -> list[str]:
+    """The module names listed in the page's ``{safepg-api}`` blocks, in order.
+
+    Parameters
+    ----------
+    text : str
+        The page's MyST source.
+
+    Returns
+    -------
+    list of str
+        One entry per non-empty line that is not a ``#`` comment.
+    """
+    names = []
+    for match in BLOCK.finditer(text):
+        for line in match["body"].splitlines():
+            line = line.split("#", 1)[0].strip()
+            if line:
+                names.append(line)
+    return names
+
+
+def public_names(modname: str) -> list[str]:
+    """The public names of a module: its ``__all__``, else what its source defines.
+
+    Parameters
+    ----------
+    modname : str
+        Dotted name of an importable module.
+
+    Returns
+    -------
+    list of str
+        ``__all__`` in its order when the module has one; otherwise the classes, functions
+        and assigned names its source defines at top level, in source order, without those
+        starting with an underscore (imported names are not the module's own).
+    """
+    module = importlib.import_module(modname)
+    if hasattr(module, "__all__"):
+        return list(module.__all__)
+    tree = ast.parse(Path(inspect.getsourcefile(module)).read_text(encoding="utf-8"))
+    names: list[str] = []
+
+    def scan(body: list[ast.stmt]) -> None:
+        for node in body:
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                found = [node.name]
+            elif isinstance(node, ast.Assign):
+                found = [t.id for t in node.targets if isinstance(t, ast.Name)]
+            elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+                found = [node.target.id]
+            elif isinstance(node, ast.If | ast.Try):
+                # Definitions that depend on an optional dependency (``try: import gymnasium``).
+                for part in (node.body, node.orelse, getattr(node, "finalbody", [])):
+                    scan(part)
+                found = []
+            else:
+                found = []
+            names.extend(n for n in found if not n.startswith("_") and n not in names)
+
+    scan(tree.body)
+    # What the import did not define (an optional dependency is missing) is not listed.
+    return [n for n in names if hasattr(module, n)]
+
+
+def _kind(obj: Any) -> str:
+    if inspect.isclass(obj):
+        return "exception" if issubclass(obj, BaseException) else "class"
+    if inspect.isroutine(obj):
+        return "function"
+    return "data"
+
+
+_ROLE = {"class": "class", "exception": "exc", "function": "func", "data": "data"}
+
+
+def module_markdown(modname: str, documented: dict[int, str], pointers: set[str] | None = None) -> str:
+    """The MyST text of one module's section.
+
+    Parameters
+    ----------
+    modname : str
+        Dotted module name.
+    documented : dict
+        ``id(object)`` -> the full name it is documented under, for the classes and
+        functions of earlier sections; this module's are added to it.
+    pointers : set of str, optional
+        Receives the full names given only a one-line entry pointing to another section.
+
+    Returns
+    -------
+    str
+        A heading, the docstring's first line, an autosummary table and one entry per name.
+    """
+    module = importlib.import_module(modname)
+    summary = (inspect.getdoc(module) or "").strip().splitlines()
+    lines = [f"({modname.replace('.', '-')})=", f"## `{modname}`", "", summary[0] if summary else "", ""]
+    rst = [f".. currentmodule:: {modname}", "", ".. autosummary::", "   :nosignatures:", ""]
+    names = public_names(modname)
+    rst += [f"   {name}" for name in names] + [""]
+    for name in names:
+        obj = getattr(module, name)
+        kind = _kind(obj)
+        # Data (a version string, a constant) has no identity worth sharing: each module's own.
+        first = documented.get(id(obj)) if kind != "data" else None
+        if first is not None:
+            if pointers is not None:
+                pointers.add(f"{modname}.{name}")
+            rst += [f".. py:{'function' if kind == 'function' else kind}:: {name}", "",
+                    f"   The same object as :py:{_ROLE[kind]}:`{first}`.", ""]
+            continue
+        if kind != "data":
+            documented[id(obj)] = f"{modname}.{name}"
+        rst.append(f".. auto{kind}:: {name}")
+        if kind in ("class", "exception"):
+            rst.append("   :members:")
+        rst.append("")
+    lines += ["```{eval-rst}", *rst, "```", ""]
+    return "\n".join(lines)
+
+
+def expand(text: str, pointers: set[str] | None = None) -> str:
+    """The page's text with each ``{safepg-api}`` block replaced by its modules' sections.
+
+    Parameters
+    ----------
+    text : str
+        The page's MyST source.
+    pointers : set of str, optional
+        Receives the names given only a one-line entry (see :func:`module_markdown`).
+
+    Returns
+    -------
+    str
+        The same text, the blocks expanded (unchanged when there is none).
+    """
+    documented: dict[int, str] = {}
+
+    def sections(match: re.Match[str]) -> str:
+        return "\n".join([STYLE] + [module_markdown(m, documented, pointers) for m in block_modules(match[0])])
+
+    return BLOCK.sub(sections, text)
+
+
+#: Inline markup (``literal``, :role:`text`, `text`): left as it is.
+_INLINE = re.compile(r"``.+?``|(?::[\w:.+-]+:)?`[^`]+`_{0,2}")
+#: ``|x|`` as docutils would read a substitution reference: no space inside its bars, no word
+#: character against them outside.
+_BARS = re.compile(r"(?<![\w|\\])\|(?=\S)([^|`]+?)(?<=\S)\|(?![\w|])")
+
+
+def plain_bars(line: str) -> str:
+    """A docstring line with each ``|...|`` outside inline markup made a literal.
+
+    Parameters
+    ----------
+    line : str
+        One line of a docstring.
+
+    Returns
+    -------
+    str
+        The line, ``|r_t|`` written ````|r_t|````; the rest unchanged.
+    """
+    out, pos = [], 0
+    for match in _INLINE.finditer(line):
+        out.append(_BARS.sub(r"``|\1|``", line[pos:match.start()]))
+        out.append(match[0])
+        pos = match.end()
+    out.append(_BARS.sub(r"``|\1|``", line[pos:]))
+    return "".join(out)
+
+
+def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: list[str]) -> None:
+    if what in ("data", "attribute") and not inspect.isclass(obj) and lines:
+        # A value with no comment of its own gets its type's docstring (``__version__`` would
+        # be described by ``str``'s): that describes the type, not the value.
+        own = inspect.cleandoc(type(obj).__doc__ or "").splitlines()
+        if [line for line in lines if line.strip()] == [line for line in own if line.strip()]:
+            lines.clear()
+    lines[:] = [plain_bars(line) for line in lines]
+
+
+def _source_read(app: Any, docname: str, source: list[str]) -> None:
+    if "{safepg-api}" in source[0]:
+        pointers: set[str] = set()
+        source[0] = expand(source[0], pointers)
+        # Kept in the environment, which outlives this read: an unchanged page is not re-read.
+        app.env.safepg_api_pointers = pointers
+
+
+def _merge(app: Any, env: Any, docnames: Any, other: Any) -> None:
+    env.safepg_api_pointers = getattr(env, "safepg_api_pointers", set()) | getattr(other, "safepg_api_pointers", set())
+
+
+def _import_dotted(name: str) -> Any:
+    """The object a dotted name designates, or None."""
+    parts = name.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        try:
+            for attr in parts[i:]:
+                obj = getattr(obj, attr)
+        except AttributeError:
+            return None
+        return obj
+    return None
+
+
+def _identity(obj: Any) -> Any:
+    # A classmethod or method read from its class is a new bound object at each access.
+    return inspect.unwrap(getattr(obj, "__func__", obj))
+
+
+def _documented(env: Any) -> dict[int, str]:
+    """``id`` of each object the Python domain documents -> its documented name."""
+    pointers = getattr(env, "safepg_api_pointers", set())
+    found: dict[int, str] = {}
+    # Full entries first, so that an object documented twice links to its full entry.
+    objects = sorted(env.get_domain("py").objects.items(), key=lambda item: item[0] in pointers)
+    for name, entry in objects:
+        if entry.aliased or entry.objtype == "module":
+            continue
+        obj = _import_dotted(name)
+        if obj is not None:
+            found.setdefault(id(_identity(obj)), name)
+    return found
+
+
+def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
+    if node.get("refdomain") != "py" or node.get("reftype") == "mod":
+        return None
+    target = node["reftarget"]
+    module, cls = node.get("py:module"), node.get("py:class")
+    candidates = [target]
+    if module:
+        candidates += [f"{module}.{cls}.{target}"] if cls else []
+        candidates.append(f"{module}.{target}")
+    documented = _documented(env)
+    for candidate in candidates:
+        obj = _import_dotted(candidate)
+        if obj is None:
+            continue
+        name = documented.get(id(_identity(obj)))
+        if name is not None:
+            py = env.get_domain("py")
+            return py.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], name, node, contnode)
+    return None
+
+
+def setup(app: Any) -> dict[str, Any]:
+    app.setup_extension("sphinx.ext.autodoc")
+    app.setup_extension("sphinx.ext.autosummary")
+    app.connect("source-read", _source_read)
+    app.connect("env-merge-info", _merge)
+    # Before numpydoc (priority 500) turns the sections into reStructuredText.
+    app.connect("autodoc-process-docstring", _docstring, priority=400)
+    app.connect("missing-reference", _missing_reference)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}
