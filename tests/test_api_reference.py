@@ -69,7 +69,7 @@ def documented(expanded: str) -> dict[str, set[str]]:
     out: dict[str, set[str]] = {}
     module = None
     for line in expanded.splitlines():
-        if m := re.match(r"\.\. currentmodule:: (\S+)$", line):
+        if m := re.match(r"\.\. (?:currentmodule|py:module):: (\S+)$", line):
             module = m[1]
             out.setdefault(module, set())
         elif m := re.match(r"\.\. (?:auto|py:)(?:class|exception|function|data):: (\S+)$", line):

@@ -144,7 +144,8 @@ def module_markdown(modname: str, documented: dict[int, str], pointers: set[str]
     module = importlib.import_module(modname)
     summary = (inspect.getdoc(module) or "").strip().splitlines()
     lines = [f"({modname.replace('.', '-')})=", f"## `{modname}`", "", summary[0] if summary else "", ""]
-    rst = [f".. currentmodule:: {modname}", "", ".. autosummary::", "   :nosignatures:", ""]
+    # A module target as well as the current module: docstrings cite modules (:mod:`safepg.store`).
+    rst = [f".. py:module:: {modname}", "", ".. autosummary::", "   :nosignatures:", ""]
     names = public_names(modname)
     rst += [f"   {name}" for name in names] + [""]
     for name in names:
@@ -224,8 +225,9 @@ def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: li
     if what in ("data", "attribute") and not inspect.isclass(obj) and lines:
         # A value with no comment of its own gets its type's docstring (``__version__`` would
         # be described by ``str``'s): that describes the type, not the value.
-        own = inspect.cleandoc(type(obj).__doc__ or "").splitlines()
-        if [line for line in lines if line.strip()] == [line for line in own if line.strip()]:
+        doc = getattr(type(obj), "__doc__", None)
+        own = inspect.cleandoc(doc).splitlines() if isinstance(doc, str) else []
+        if own and [line for line in lines if line.strip()] == [line for line in own if line.strip()]:
             lines.clear()
     lines[:] = [plain_bars(line) for line in lines]
 
