@@ -192,33 +192,67 @@ def expand(text: str, pointers: set[str] | None = None) -> str:
     return BLOCK.sub(sections, text)
 
 
-#: Inline markup (``literal``, :role:`text`, `text`): left as it is.
-_INLINE = re.compile(r"``.+?``|(?::[\w:.+-]+:)?`[^`]+`_{0,2}")
-#: ``|x|`` as docutils would read a substitution reference: no space inside its bars, no word
-#: character against them outside.
-_BARS = re.compile(r"(?<![\w|\\])\|(?=\S)([^|`]+?)(?<=\S)\|(?![\w|])")
+#: Inline markup (``literal``, :role:`text`, `text`), which may continue on the next line:
+#: left as it is.
+_INLINE = re.compile(r"``.+?``|(?::[\w:.+-]+:)?`[^`]+`_{0,2}", re.DOTALL)
+#: ``|x|`` as docutils would read a substitution reference: on one line, no space inside its
+#: bars, no word character against them outside.
+_BARS = re.compile(r"(?<![\w|\\])\|(?=\S)([^|`\n]+?)(?<=\S)\|(?![\w|])")
+#: A directive (``.. math::``) or a paragraph ending in ``::``: its indented body is not text.
+_BLOCK_START = re.compile(r"^(\s*)(?:\.\. [\w:-]+::.*|.*::)$")
 
 
-def plain_bars(line: str) -> str:
-    """A docstring line with each ``|...|`` outside inline markup made a literal.
+def _plain_text(text: str) -> str:
+    out, pos = [], 0
+    for match in _INLINE.finditer(text):
+        out.append(_BARS.sub(r"``|\1|``", text[pos:match.start()]))
+        out.append(match[0])
+        pos = match.end()
+    out.append(_BARS.sub(r"``|\1|``", text[pos:]))
+    return "".join(out)
+
+
+def plain_bars(lines: list[str]) -> list[str]:
+    """A docstring's lines with each ``|...|`` of its running text made a literal.
 
     Parameters
     ----------
-    line : str
-        One line of a docstring.
+    lines : list of str
+        The docstring, a line per entry.
 
     Returns
     -------
-    str
-        The line, ``|r_t|`` written ````|r_t|````; the rest unchanged.
+    list of str
+        The same lines, ``|r_t|`` written ````|r_t|```` outside inline markup (which may
+        span lines), directives (``.. math::``) and literal blocks, which are left as they are.
     """
-    out, pos = [], 0
-    for match in _INLINE.finditer(line):
-        out.append(_BARS.sub(r"``|\1|``", line[pos:match.start()]))
-        out.append(match[0])
-        pos = match.end()
-    out.append(_BARS.sub(r"``|\1|``", line[pos:]))
-    return "".join(out)
+    out: list[str] = []
+    text: list[str] = []  # the running text since the last block
+    body_indent: int | None = None  # inside a directive's or literal block's body
+
+    def flush() -> None:
+        if text:
+            out.extend(_plain_text("\n".join(text)).split("\n"))
+            text.clear()
+
+    for line in lines:
+        indent = len(line) - len(line.lstrip())
+        if body_indent is not None and (not line.strip() or indent > body_indent):
+            out.append(line)
+            continue
+        body_indent = None
+        block = _BLOCK_START.match(line)
+        if block and line.lstrip().startswith(".. "):
+            flush()
+            out.append(line)
+            body_indent = len(block[1])
+            continue
+        text.append(line)
+        if block:  # "...::" ends a paragraph that introduces a literal block
+            flush()
+            body_indent = len(block[1])
+    flush()
+    return out
 
 
 def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: list[str]) -> None:
@@ -229,7 +263,7 @@ def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: li
         own = inspect.cleandoc(doc).splitlines() if isinstance(doc, str) else []
         if own and [line for line in lines if line.strip()] == [line for line in own if line.strip()]:
             lines.clear()
-    lines[:] = [plain_bars(line) for line in lines]
+    lines[:] = plain_bars(lines)
 
 
 def _source_read(app: Any, docname: str, source: list[str]) -> None:
