@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import re
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -22,7 +23,7 @@ from safepg.thesis import errata
 from safepg.thesis import scorecard as sc
 from safepg.thesis.experiments import get_experiment, run_experiment, scaled
 from safepg.thesis.scorecard import links as sc_links
-from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 
 BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2d", "cartpole", "errata"}
 
@@ -121,19 +122,29 @@ def test_every_rule_is_stated():
 
 
 # ------------------------------------------------------------------ statuses
+class Why(NamedTuple):
+    why: str
+
+
+def _spec(row_id: str, ok: bool | None, **more) -> RowSpec:
+    """A synthetic row of Section 5.1 judged by the rounding rule."""
+    judgement = {"rule": "rounded", "kind": "one run", **more}
+    return RowSpec(id=row_id, group="Section 5.1", quantity="q", where="w", page="lqg2d", heading="Table 5.3",
+                   thesis="1", ours="2", difference="+1", ok=ok, **judgement)
+
+
 def test_status_follows_rule_and_note(monkeypatch):
-    monkeypatch.setitem(sc.NOTES, "x/explained", sc.Note("Because of {why}.", "lqg1d", "Table 5.1"))
-    monkeypatch.setitem(sc.NOTES, "x/known", sc.Note("Open: {why}.", "lqg1d", "Table 5.2", explains=False))
+    monkeypatch.setitem(sc.NOTES, "x/explained", sc.Note("Because of {why}.", "lqg1d", "Table 5.1", measured=Why))
+    monkeypatch.setitem(sc.NOTES, "x/known", sc.Note("Open: {why}.", "lqg1d", "Table 5.2", explains=False,
+                                                     measured=Why))
     b = Builder()
-    b.values["why"] = "a reason"
-    common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
-                  rule="rounded", kind="one run", page="lqg2d", heading="Table 5.3")
-    b.add(id="x/ok", ok=True, **common)
-    b.add(id="x/explained", ok=False, **common)
-    b.add(id="x/known", ok=False, **common)
-    b.add(id="x/unknown", ok=False, **common)
-    b.add(id="x/missing", ok=None, **common)
-    b.add(id="x/explained", ok=None, **common)  # no runs: nothing was compared, whatever the note says
+    why = Why("a reason")
+    b.add(_spec("x/ok", True))
+    b.add(_spec("x/explained", False, note_values=why))
+    b.add(_spec("x/known", False, note_values=why))
+    b.add(_spec("x/unknown", False))
+    b.add(_spec("x/missing", None))
+    b.add(_spec("x/explained", None))  # no runs: nothing was compared, whatever the note says
     got = [(r.status, r.explanation) for r in b.rows]
     assert got[0] == ("reproduced", "")
     assert got[1] == ("differs (explained)", "Because of a reason.")
@@ -145,22 +156,23 @@ def test_status_follows_rule_and_note(monkeypatch):
     assert b.rows[0].link.startswith("lqg2d.html#") and b.rows[1].link.startswith("lqg1d.html#table-5-1")
     assert [r.judged_on for r in b.rows] == ["ours", "ours", "ours", "ours", "", ""]
     with pytest.raises(ValueError, match="rule"):
-        b.add(id="x/bad", ok=True, **{**common, "rule": "nope"})
+        _spec("x/bad", True, rule="nope")
     with pytest.raises(ValueError, match="kind"):
-        b.add(id="x/bad", ok=True, **{**common, "kind": "a guess"})
+        _spec("x/bad", True, kind="a guess")
 
 
 def test_status_judged_on_the_authors_column(monkeypatch):
     monkeypatch.setitem(sc.NOTES, "y/explained", sc.Note("Because.", "lqg1d", "Table 5.1"))
     b = Builder()
-    common = dict(group="Section 5.1", quantity="q", where="w", thesis="1", ours="2", difference="+1",
-                  rule="rounded", kind="one run", page="lqg2d", heading="Table 5.3", authors="1.0",
-                  authors_note="Their θ0 did it.")
-    b.add(id="y/both", ok=True, authors_ok=True, **common)  # ours first: the text's settings suffice
-    b.add(id="y/authors", ok=False, authors_ok=True, **common)
-    b.add(id="y/explained", ok=False, authors_ok=False, **common)
-    b.add(id="y/none", ok=False, authors_ok=None, **common)  # authors' runs missing: judged on ours alone
-    b.add(id="y/slip", ok=True, slip_note="Slip: 37.64% against 37.4%.", **common)
+
+    def authors(ok: bool | None) -> AuthorsColumn:
+        return AuthorsColumn(text="1.0", ok=ok, note="Their θ0 did it.")
+
+    b.add(_spec("y/both", True, authors=authors(True)))  # ours first: the text's settings suffice
+    b.add(_spec("y/authors", False, authors=authors(True)))
+    b.add(_spec("y/explained", False, authors=authors(False)))
+    b.add(_spec("y/none", False, authors=authors(None)))  # authors' runs missing: judged on ours alone
+    b.add(_spec("y/slip", True, slip_note="Slip: 37.64% against 37.4%.", authors=authors(None)))
     got = [(r.status, r.judged_on, r.explanation) for r in b.rows]
     assert got[0] == ("reproduced", "ours", "")
     assert got[1] == (sc.AUTHORS_STATUS, "authors' settings", "Their θ0 did it.")
@@ -363,6 +375,9 @@ def test_missing_runs_are_open_not_reproduced(tmp_path):
     measured = [r for r in rows if r.id.startswith(("table-5.", "figures-5.5", "section-5.3/"))]
     assert measured and all(r.status == "open" and r.ours_value is None for r in measured)
     assert all(r.explanation for r in measured)
+    # A missing run is said by its own sentence; no note is left with an unfilled value.
+    assert all("(not computed)" not in r.explanation for r in rows)
+    assert all(r.explanation.startswith("Not computed: the runs behind this row are missing") for r in measured)
 
 
 def test_unknown_experiment_name_is_refused():

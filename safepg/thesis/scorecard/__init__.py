@@ -28,10 +28,12 @@ when the chapter explains the gap (the sentence is kept with the row, :data:`NOT
 Modules (their public names used outside the package are available here):
 
 - :mod:`~safepg.thesis.scorecard.rules`: statuses, groups, :data:`PRINTED`, :data:`RULES`,
-  :data:`NOTES`, :class:`Row` and the tolerance functions that apply the rules;
+  :data:`NOTES` (each with the measured values it quotes, a NamedTuple), :class:`Row` and the
+  tolerance functions that apply the rules;
 - :mod:`~safepg.thesis.scorecard.links`: the book's folder :data:`BOOK` and :func:`book_link`;
 - :mod:`~safepg.thesis.scorecard.text`: the cells' texts (percentages, intervals, closed forms);
-- :mod:`~safepg.thesis.scorecard.builder`: the row builder, which applies the rules and the notes;
+- :mod:`~safepg.thesis.scorecard.builder`: :class:`~safepg.thesis.scorecard.builder.RowSpec`, what a
+  row says before it is judged, and the row builder, which applies the rules and the notes;
 - :mod:`~safepg.thesis.scorecard.closed_forms`: the rows of the printed statements and the LQG's
   closed forms;
 - :mod:`~safepg.thesis.scorecard.runs`: the rows of the Chapter 5 runs;

@@ -1,13 +1,14 @@
-"""The row builder: each row gets its status by its rule, the column it holds on, and the notes;
-and its link."""
+"""The row builder: each row, given as a :class:`RowSpec`, gets its status by its rule, the column it
+holds on, and the notes; and its link."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from safepg.thesis.scorecard.links import BOOK, book_link
+from safepg.thesis.scorecard.outputs import Output
 from safepg.thesis.scorecard.rules import (
     AUTHORS_ERROR_STATUS,
     AUTHORS_STATUS,
@@ -19,11 +20,167 @@ from safepg.thesis.scorecard.rules import (
     Row,
     Status,
 )
-from safepg.thesis.scorecard.text import fill
 
 #: Where the chapters discuss the authors' settings (the heading's words; without such a heading
 #: the link is the chapter's page).
 AUTHORS_HEADING = "authors"
+
+
+@dataclass(frozen=True, kw_only=True)
+class AuthorsColumn:
+    """Ours under the authors' settings, beside a row (the default: the row has no such column).
+
+    Attributes
+    ----------
+    experiment : str
+        The experiment behind the column (e.g. ``"table-5.1-authors"``), or what was computed.
+    text : str
+        The cell ("-" when its runs are not stored).
+    value, ci95, seeds
+        The number, our 95% interval and the seeds behind ``text``.
+    ok : bool or None
+        The row's rule on this column (None: no such run, or not all its seeds stored).
+    interval, interval_text : list of float or None, str
+        The interval the rule was applied to, and as the page shows it.
+    vacuous : str
+        Why the column's agreement carries no information ("" when it does).
+    note : str
+        Which setting reproduces the printed value: the row's explanation when its status is
+        judged on this column.
+    error : bool
+        The column reproduces the printed value only through an error of the authors' code.
+    """
+
+    experiment: str = ""
+    text: str = ""
+    value: float | None = None
+    ci95: list[float] | None = None
+    seeds: int | None = None
+    ok: bool | None = None
+    interval: list[float] | None = None
+    interval_text: str = ""
+    vacuous: str = ""
+    note: str = ""
+    error: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class RowSpec:
+    """What a row says before it is judged: :meth:`Builder.add` turns it into a :class:`Row`.
+
+    Where the row stands: ``id``, ``group``, ``quantity``, ``where``, and the book's ``page`` and
+    ``heading`` that discuss it. The printed and our values: ``thesis``, ``ours``, ``difference`` (the
+    cells), ``thesis_value``, ``ours_value``, ``ours_ci95``, ``seeds``, ``thesis_tex``, ``ours_tex`` and
+    ``fields`` (as in :class:`Row`). The judgement: ``ok`` (the rule on ours; None: nothing to
+    compare, missing runs), ``rule`` (a key of :data:`RULES`), ``kind`` (one of :data:`KINDS`),
+    ``interval`` and ``interval_text`` (what the rule was applied to), ``vacuous`` (why ours agrees
+    without information, "" when it does not) and ``expected_seeds`` (a row measured on fewer seeds
+    is not judged on ours: a partly computed campaign). Beside it: ``authors``, ours under the
+    authors' settings, and ``output``, the authors' own output. The notes: ``note_id`` (the
+    :data:`NOTES` entry, default the row's id), ``note_values`` (the values that note quotes, an
+    instance of its :attr:`Note.measured`), ``explanation`` (instead of the note's), ``slip_note``
+    (the printed value is not the authors' own output) and ``remark``, both added to any explanation.
+
+    Raises
+    ------
+    ValueError
+        If ``rule`` or ``kind`` is not one of the stated ones.
+    """
+
+    id: str
+    group: str
+    quantity: str
+    where: str
+    page: str
+    heading: str
+    thesis: str
+    ours: str
+    difference: str
+    thesis_value: float | None = None
+    ours_value: float | None = None
+    ours_ci95: list[float] | None = None
+    seeds: int | None = None
+    thesis_tex: str = ""
+    ours_tex: str = ""
+    fields: dict[str, Any] = field(default_factory=dict)
+    ok: bool | None
+    rule: str
+    kind: str
+    interval: list[float] | None = None
+    interval_text: str = ""
+    vacuous: str = ""
+    expected_seeds: int | None = None
+    authors: AuthorsColumn = AuthorsColumn()
+    output: Output | None = None
+    note_id: str | None = None
+    note_values: NamedTuple | None = None
+    explanation: str | None = None
+    slip_note: str = ""
+    remark: str = ""
+
+    def __post_init__(self) -> None:
+        if self.rule not in RULES:
+            raise ValueError(f"rule must be one of {sorted(RULES)}, got {self.rule!r}")
+        if self.kind not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got {self.kind!r}")
+
+
+def note_of(row_id: str) -> Note | None:
+    """The :data:`NOTES` entry of a row: by its id, else by the first prefix (ending in "/") of it."""
+    if row_id in NOTES:
+        return NOTES[row_id]
+    for key, n in NOTES.items():
+        if key.endswith("/") and row_id.startswith(key):
+            return n
+    return None
+
+
+def partly_computed(spec: RowSpec) -> bool:
+    """The row's runs are stored for some of its seeds only (none stored is the missing runs' case)."""
+    return spec.expected_seeds is not None and spec.seeds is not None and 0 < spec.seeds < spec.expected_seeds
+
+
+def _status(ok: bool | None, spec: RowSpec, note: Note | None) -> tuple[Status, str]:
+    """The row's status and the column it was judged on, by :data:`~safepg.thesis.scorecard.rules.STATUS_RULE`."""
+    a = spec.authors
+    judged_on = "ours" if ok is not None else ""
+    if ok and not spec.vacuous:
+        return "reproduced", judged_on
+    if a.ok and not a.vacuous:
+        return (AUTHORS_ERROR_STATUS if a.error else AUTHORS_STATUS), "authors' settings"
+    if ok and spec.vacuous:
+        return VACUOUS_STATUS, judged_on
+    if a.ok and a.vacuous:
+        return VACUOUS_STATUS, "authors' settings"
+    if ok is not None and note is not None and note.explains:
+        return "differs (explained)", judged_on
+    return "open", judged_on
+
+
+def _explanation(ok: bool | None, explanation: str | None, status: Status, judged_on: str, spec: RowSpec,
+                 note: Note | None) -> str:
+    """The row's sentence: the setting that did it, why it agrees without information, the note, or
+    what is missing; then its slip and its remark."""
+    a = spec.authors
+    if status in (AUTHORS_STATUS, AUTHORS_ERROR_STATUS):
+        explanation = a.note or explanation or ""
+        if ok and spec.vacuous:
+            explanation += f" Ours (the thesis's text) agrees too, without information: {spec.vacuous}"
+    elif status == VACUOUS_STATUS:
+        explanation = " ".join(t for t in (spec.vacuous if judged_on == "ours" else a.vacuous, explanation) if t)
+    elif explanation is None:
+        if ok is None:
+            explanation = "Not computed: the runs behind this row are missing from the results store."
+        elif note is not None and not ok:
+            explanation = note.fill(spec.note_values)
+        elif status == "open":
+            # No chapter explains this gap yet: say so, and what would settle it.
+            also = ", and so does ours under the authors' settings" if a.ok is False else ""
+            explanation = (f"Open: ours misses this row's rule{also}, and no chapter explains the gap yet; "
+                           "what is missing is the setting or the run that accounts for it.")
+        else:
+            explanation = ""
+    return " ".join(t for t in (explanation, spec.slip_note, spec.remark) if t)
 
 
 @dataclass
@@ -32,89 +189,69 @@ class Builder:
 
     book: Path = BOOK
     rows: list[Row] = field(default_factory=list)
-    values: dict[str, Any] = field(default_factory=dict)
 
-    def note(self, row_id: str) -> Note | None:
-        if row_id in NOTES:
-            return NOTES[row_id]
-        for key, n in NOTES.items():
-            if key.endswith("/") and row_id.startswith(key):
-                return n
-        return None
+    def add(self, spec: RowSpec | None = None, /, **legacy: Any) -> None:
+        """Append the row ``spec`` describes, judged.
 
-    def add(self, *, id: str, group: str, quantity: str, where: str, thesis: str, ours: str, difference: str,
-            ok: bool | None, rule: str, kind: str, page: str, heading: str, note_id: str | None = None,
-            explanation: str | None = None, expected_seeds: int | None = None, authors_ok: bool | None = None,
-            authors_note: str = "", slip_note: str = "", remark: str = "", interval: list[float] | None = None,
-            interval_text: str = "", authors_interval: list[float] | None = None, authors_interval_text: str = "",
-            vacuous: str = "", authors_vacuous: str = "", authors_error: bool = False, **extra: Any) -> None:
-        """Append a row.
+        ``legacy``: the former keywords (``authors_ok=...``, ``seeds=...``), for the callers not yet
+        written with :class:`RowSpec` (:func:`spec_from_keywords`); not with ``spec``.
 
-        ``ok``: the rule on ours (None: nothing to compare, missing runs). A row measured on
-        fewer seeds than ``expected_seeds`` is not judged on ours (a partly computed campaign).
-        ``authors_ok``: the same rule on ours under the authors' settings (None: no such run,
-        or not all its seeds stored); ``authors_note`` says which setting reproduces the printed
-        value, the row's explanation when the status is judged on that column; ``authors_error``: that
-        column reproduces it only through an error of the authors' code. ``slip_note`` (the printed
-        value is not the authors' own output) and ``remark`` are added to any explanation.
-        ``kind``: one of :data:`~safepg.thesis.scorecard.rules.KINDS`. ``interval`` / ``authors_interval``
-        (with their texts): the interval each column's rule was applied to. ``vacuous`` /
-        ``authors_vacuous``: why that column's agreement carries no information ("" when it does).
+        Raises
+        ------
+        MissingValueError
+            If the row's note is filled and quotes values the row does not give.
         """
-        if rule not in RULES:
-            raise ValueError(f"rule must be one of {sorted(RULES)}, got {rule!r}")
-        if kind not in KINDS:
-            raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-        seeds = extra.get("seeds")
-        if expected_seeds is not None and seeds is not None and 0 < seeds < expected_seeds:
-            ok, explanation = None, f"Not judged: only {seeds} of {expected_seeds} seeds are in the results store."
-        note = self.note(note_id or id)
-        informative, a_informative = bool(ok) and not vacuous, bool(authors_ok) and not authors_vacuous
-        judged_on = "ours" if ok is not None else ""
-        if informative:
-            status: Status = "reproduced"
-        elif a_informative:
-            status, judged_on = AUTHORS_ERROR_STATUS if authors_error else AUTHORS_STATUS, "authors' settings"
-        elif ok and vacuous:
-            status = VACUOUS_STATUS
-        elif authors_ok and authors_vacuous:
-            status, judged_on = VACUOUS_STATUS, "authors' settings"
-        elif ok is not None and note is not None and note.explains:
-            status = "differs (explained)"
-        else:
-            status = "open"
-        # An agreement without information, on a column the status did not come from, is still said.
-        no_information = (vacuous if ok else "") or (authors_vacuous if authors_ok else "")
-        if status in (AUTHORS_STATUS, AUTHORS_ERROR_STATUS):
-            explanation = authors_note or explanation or ""
-            if ok and vacuous:
-                explanation += f" Ours (the thesis's text) agrees too, without information: {vacuous}"
-        elif status == VACUOUS_STATUS:
-            explanation = " ".join(t for t in (vacuous if judged_on == "ours" else authors_vacuous, explanation) if t)
-        elif explanation is None:
-            if ok is None:
-                explanation = "Not computed: the runs behind this row are missing from the results store."
-            elif note is not None and not ok:
-                explanation = fill(note.text, self.values)
-            elif status == "open":
-                # No chapter explains this gap yet: say so, and what would settle it.
-                also = ", and so does ours under the authors' settings" if authors_ok is False else ""
-                explanation = (f"Open: ours misses this row's rule{also}, and no chapter explains the gap yet; "
-                               "what is missing is the setting or the run that accounts for it.")
-            else:
-                explanation = ""
-        explanation = " ".join(t for t in (explanation, slip_note, remark) if t)
-        if status in (AUTHORS_STATUS, AUTHORS_ERROR_STATUS):
-            link = book_link(page, AUTHORS_HEADING, self.book)
-        elif note is not None and not ok:
-            link = book_link(note.page, note.heading, self.book)
-        else:
-            link = book_link(page, heading, self.book)
+        if spec is None:
+            spec = spec_from_keywords(**legacy)
+        elif legacy:
+            raise TypeError(f"give a RowSpec or keywords, not both: {sorted(legacy)}")
+        ok, explanation = spec.ok, spec.explanation
+        if partly_computed(spec):
+            ok, explanation = None, (f"Not judged: only {spec.seeds} of {spec.expected_seeds} seeds are in the "
+                                     "results store.")
+        note = note_of(spec.note_id or spec.id)
+        status, judged_on = _status(ok, spec, note)
+        a, out = spec.authors, spec.output or Output(value=None, text="", source="")
         on_authors = judged_on == "authors' settings"
-        self.rows.append(Row(id=id, group=group, quantity=quantity, where=where, thesis=thesis, ours=ours,
-                             difference=difference, status=status, rule=rule, explanation=explanation,
-                             link=link, judged_on=judged_on, slip=bool(slip_note), kind=kind,
-                             judged_interval=authors_interval if on_authors else interval,
-                             judged_interval_text=authors_interval_text if on_authors else interval_text,
-                             judged_seeds=extra.get("authors_seeds" if on_authors else "seeds"),
-                             no_information=no_information, **extra))
+        # An agreement without information, on a column the status did not come from, is still said.
+        no_information = (spec.vacuous if ok else "") or (a.vacuous if a.ok else "")
+        self.rows.append(Row(
+            id=spec.id, group=spec.group, quantity=spec.quantity, where=spec.where, thesis=spec.thesis,
+            ours=spec.ours, difference=spec.difference, status=status, rule=spec.rule,
+            explanation=_explanation(ok, explanation, status, judged_on, spec, note),
+            link=self._link(status, ok, spec, note), thesis_value=spec.thesis_value, ours_value=spec.ours_value,
+            ours_ci95=spec.ours_ci95, seeds=spec.seeds, thesis_tex=spec.thesis_tex, ours_tex=spec.ours_tex,
+            fields=spec.fields, judged_on=judged_on, authors=a.text, authors_value=a.value, authors_ci95=a.ci95,
+            authors_seeds=a.seeds, authors_experiment=a.experiment, authors_output=out.text,
+            authors_output_value=out.value, authors_output_source=out.source, slip=bool(spec.slip_note),
+            kind=spec.kind, judged_interval=a.interval if on_authors else spec.interval,
+            judged_interval_text=a.interval_text if on_authors else spec.interval_text,
+            judged_seeds=a.seeds if on_authors else spec.seeds, no_information=no_information))
+
+    def _link(self, status: Status, ok: bool | None, spec: RowSpec, note: Note | None) -> str:
+        """Where the row's status is discussed: the authors' settings, its note's section, or its own."""
+        if status in (AUTHORS_STATUS, AUTHORS_ERROR_STATUS):
+            return book_link(spec.page, AUTHORS_HEADING, self.book)
+        if note is not None and not ok:
+            return book_link(note.page, note.heading, self.book)
+        return book_link(spec.page, spec.heading, self.book)
+
+
+#: The former keywords of ``Builder.add`` that name a field of :class:`AuthorsColumn` or :class:`Output`.
+_AUTHORS_KEYWORDS = {"authors": "text", "authors_experiment": "experiment", "authors_value": "value",
+                     "authors_ci95": "ci95", "authors_seeds": "seeds", "authors_ok": "ok",
+                     "authors_interval": "interval", "authors_interval_text": "interval_text",
+                     "authors_vacuous": "vacuous", "authors_note": "note", "authors_error": "error"}
+_OUTPUT_KEYWORDS = {"authors_output": "text", "authors_output_value": "value", "authors_output_source": "source"}
+
+
+def spec_from_keywords(**keywords: Any) -> RowSpec:
+    """A :class:`RowSpec` from the former flat keywords of ``Builder.add`` (``authors_ok``, ...).
+
+    Kept while tests/test_verdicts.py builds its synthetic rows that way; every keyword still names a
+    declared field (an unknown one raises TypeError, as does a missing required one).
+    """
+    authors = {_AUTHORS_KEYWORDS[k]: keywords.pop(k) for k in list(keywords) if k in _AUTHORS_KEYWORDS}
+    output = {_OUTPUT_KEYWORDS[k]: keywords.pop(k) for k in list(keywords) if k in _OUTPUT_KEYWORDS}
+    return RowSpec(**keywords, authors=AuthorsColumn(**authors),
+                   output=Output(**{"value": None, "text": "", "source": "", **output}) if output else None)

@@ -13,9 +13,9 @@ from safepg.envs.lqg import LQG
 from safepg.thesis import authors, errata
 from safepg.thesis.experiments import LQG2D_GAMMA
 from safepg.thesis.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
-from safepg.thesis.scorecard.builder import Builder
-from safepg.thesis.scorecard.rules import GROUPS, NOTES, PRINTED, within_rounding
-from safepg.thesis.scorecard.text import expr_tex, expr_text, fill, signed
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
+from safepg.thesis.scorecard.rules import GROUPS, NOTES, PRINTED, ClosedFormJ, PrintedDiscount, within_rounding
+from safepg.thesis.scorecard.text import expr_tex, expr_text, signed
 
 
 def _theory_group(location: str) -> str:
@@ -83,10 +83,10 @@ def _theory_rows(b: Builder) -> None:
         else:  # "supports": the derivation proves the printed claim (its method says how)
             ok, diff = True, "proved"
         page, heading = _theory_link(v.location)
-        b.add(id=f"theory/{v.id}", group=_theory_group(v.location), quantity=THEORY_LABELS.get(v.id, v.id),
+        b.add(RowSpec(id=f"theory/{v.id}", group=_theory_group(v.location), quantity=THEORY_LABELS.get(v.id, v.id),
               where=v.location, thesis=expr_text(printed), ours=expr_text(derived), difference=diff, ok=ok,
               rule="closed-form", kind="closed form", page=page, heading=heading, thesis_tex=expr_tex(printed),
-              ours_tex=expr_tex(derived), explanation="" if ok else f"Checked by: {v.method}.")
+              ours_tex=expr_tex(derived), explanation="" if ok else f"Checked by: {v.method}."))
     for e in errata.errata():
         if e.kind in ("reference", "proof"):  # cross-reference typos and proof steps are not results
             continue
@@ -97,21 +97,21 @@ def _theory_rows(b: Builder) -> None:
             if sp.count_ops(ratio) <= 4:
                 diff = f"printed / ours = {expr_text(ratio)}"
         first = re.split(r"(?<=\.)\s", e.explanation, maxsplit=1)[0]
-        b.add(id=f"theory/{e.id}", group=_theory_group(e.location), quantity=THEORY_LABELS.get(e.id, e.id),
+        b.add(RowSpec(id=f"theory/{e.id}", group=_theory_group(e.location), quantity=THEORY_LABELS.get(e.id, e.id),
               where=e.location, thesis=expr_text(printed), ours=expr_text(corrected), difference=diff,
               ok=False, rule="closed-form", kind="closed form", page="errata", heading="Errata",
               note_id="theory/erratum",
-              explanation=first, thesis_tex=expr_tex(printed), ours_tex=expr_tex(corrected))
+              explanation=first, thesis_tex=expr_tex(printed), ours_tex=expr_tex(corrected)))
     # The decimal the thesis prints for the guarantee's constant, (393 - 95 sqrt 17) / 8 >= 0.16.
     printed_coeff = sp.simplify(errata.printed_theorem_4_3_2()["improvement_star"] / theory.g**2)
     value = float(printed_coeff)
     text = PRINTED["thm_4_3_2_decimal"]
-    b.add(id="theory/thm_4_3_2_decimal", group=GROUPS[0], quantity="decimal value of (393 - 95√17)/8",
+    b.add(RowSpec(id="theory/thm_4_3_2_decimal", group=GROUPS[0], quantity="decimal value of (393 - 95√17)/8",
           where="Theorem 4.3.2 (statement)", thesis=f"≥ {text}", ours=f"{value:.4f}",
           difference=signed(value - float(text), 4), ok=value >= float(text) and within_rounding(value, text),
           rule="rounded", kind="closed form", page="adaptive_batch", heading="Theorem 4.3.2", thesis_value=float(text),
           ours_value=value,
-          explanation="The decimal is right; the guarantee it multiplies lacks a factor 1/(4c) (see the errata).")
+          explanation="The decimal is right; the guarantee it multiplies lacks a factor 1/(4c) (see the errata)."))
 
 
 def _lqg_rows(b: Builder) -> None:
@@ -122,40 +122,40 @@ def _lqg_rows(b: Builder) -> None:
     for rid, q, printed, ours in (("section-5.1/theta-star", "optimal parameter θ*", PRINTED["lqg1d_theta_star"],
                                    k1),
                                   ("section-5.1/J-star", "J(θ*)", PRINTED["lqg1d_J_star"], j1)):
-        b.add(id=rid, group="Section 5.1", quantity=q + " (closed form, γ = 0.9)", where="Section 5.1",
+        b.add(RowSpec(id=rid, group="Section 5.1", quantity=q + " (closed form, γ = 0.9)", where="Section 5.1",
               thesis=f"≈ {printed}", ours=f"{ours:.4f}", difference=signed(ours - float(printed), 4),
               ok=within_rounding(ours, printed), rule="rounded", kind="closed form", page="preliminaries",
               heading="task",
-              thesis_value=float(printed), ours_value=ours)
+              thesis_value=float(printed), ours_value=ours))
     used = LQG.thesis_2d(gamma=LQG2D_GAMMA)
     printed_setting = LQG.thesis_2d()
     K = used.optimal_gain()
     Kp = printed_setting.optimal_gain()
-    b.values.update(theta_printed_setting=float(Kp[0, 0]), J_used=float(used.performance(K, 1.0)),
-                    J_printed_setting=float(printed_setting.performance(Kp, 1.0)),
-                    J0_printed_setting=float(printed_setting.performance(np.zeros_like(Kp), 1.0)))
+    j_values = ClosedFormJ(J_used=float(used.performance(K, 1.0)),
+                           J_printed_setting=float(printed_setting.performance(Kp, 1.0)))
     theta_text = repr(PRINTED_THETA_STAR)
     t11 = float(K[0, 0])
-    b.add(id="section-5.2/theta-star", group="Section 5.2", quantity="optimal parameter θ*₁₁ = θ*₂₂ "
+    b.add(RowSpec(id="section-5.2/theta-star", group="Section 5.2", quantity="optimal parameter θ*₁₁ = θ*₂₂ "
           "(2-D LQG)", where="Section 5.2.1", thesis=f"≈ {theta_text}", ours=f"{t11:.4f}",
           difference=signed(t11 - PRINTED_THETA_STAR, 4), ok=within_rounding(t11, theta_text)
           and float(np.abs(K[0, 1])) == 0 and float(np.abs(K[1, 0])) == 0, rule="rounded", kind="closed form",
           page="lqg2d", heading="setting as printed", thesis_value=PRINTED_THETA_STAR, ours_value=t11,
-          explanation=fill(NOTES["section-5.2/theta-star"].text, b.values))
-    j2 = b.values["J_used"]
+          explanation=NOTES["section-5.2/theta-star"].fill(PrintedDiscount(float(Kp[0, 0])))))
+    j2 = j_values.J_used
     j_text = repr(PRINTED_J_STAR)
     # Their code's J (lqgnd/lqgnd.py@92ac378:226-227) at our theta*: 16 times the expectation.
     theirs = authors.lqg2d_performance(K, 1.0, LQG2D_GAMMA)
-    b.add(id="section-5.2/J-star", group="Section 5.2", quantity="J(θ*) (2-D LQG)", where="Section 5.2.1",
+    b.add(RowSpec(id="section-5.2/J-star", group="Section 5.2", quantity="J(θ*) (2-D LQG)", where="Section 5.2.1",
           thesis=f"≈ {j_text}", ours=f"{j2:.3f}", difference=signed(j2 - PRINTED_J_STAR, 3),
           ok=within_rounding(j2, j_text), rule="rounded", kind="closed form", page="lqg2d",
-          heading="setting as printed", thesis_value=PRINTED_J_STAR, ours_value=j2, authors=f"{theirs:.5f}",
-          authors_value=theirs, authors_experiment="safepg.thesis.authors.lqg2d_performance",
-          authors_ok=within_rounding(theirs, j_text), authors_error=True,
-          authors_note=f"Reproduced only by an error in the authors' code, not by a setting: their J "
-                       f"(lqgnd/lqgnd.py@92ac378:226-227) is 16 times the expectation (the integral of s0'P s0 + W "
-                       f"over the initial-state box [-2, 2]², not its mean); at γ = 0.9 it gives {theirs:.5f} at "
-                       f"θ* = diag({t11:.6f}), where the expectation is {j2:.4f}.")
+          heading="setting as printed", thesis_value=PRINTED_J_STAR, ours_value=j2, note_values=j_values,
+          authors=AuthorsColumn(
+              text=f"{theirs:.5f}", value=theirs, experiment="safepg.thesis.authors.lqg2d_performance",
+              ok=within_rounding(theirs, j_text), error=True,
+              note=f"Reproduced only by an error in the authors' code, not by a setting: their J "
+                   f"(lqgnd/lqgnd.py@92ac378:226-227) is 16 times the expectation (the integral of s0'P s0 + W "
+                   f"over the initial-state box [-2, 2]², not its mean); at γ = 0.9 it gives {theirs:.5f} at "
+                   f"θ* = diag({t11:.6f}), where the expectation is {j2:.4f}.")))
 
 
 def closed_form_rows(b: Builder) -> None:

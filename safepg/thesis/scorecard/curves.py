@@ -12,7 +12,8 @@ from typing import Any
 
 from safepg.learning import LearningRecord
 from safepg.thesis.curve_bands import CURVE_SHARE, CurveScore, curve_holds, curve_scores, outside_sentence
-from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
+from safepg.thesis.scorecard.outputs import Output
 
 #: Experiments under the authors' settings: a curve scored on one of them fills the row's authors' column.
 AUTHORS_SETTINGS = ("table-5.3-authors", "table-5.4-authors-theta-star")
@@ -77,21 +78,19 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         group, page, heading = FIGURE_PLACES[figure]
         ours, theirs = (_column(sides[k]) if k in sides else None for k in ("ours", "authors"))
         first = (ours or theirs)["worst"]  # type: ignore[index]
-        authors: dict[str, Any] = {}
-        if theirs is not None:
-            authors = {"authors": theirs["text"], "authors_value": theirs["share"], "authors_ok": theirs["holds"],
-                       "authors_seeds": theirs["seeds"], "authors_experiment": theirs["worst"].experiment,
-                       "authors_interval_text": theirs["band"], "authors_note": AUTHORS_NOTES.get(figure, "")}
+        authors = AuthorsColumn() if theirs is None else AuthorsColumn(
+            text=theirs["text"], value=theirs["share"], ok=theirs["holds"], seeds=theirs["seeds"],
+            experiment=theirs["worst"].experiment, interval_text=theirs["band"], note=AUTHORS_NOTES.get(figure, ""))
         remark = " ".join(f"{label}: their curve {outside_sentence(c['worst'])}"
                           for label, c in (("Ours", ours), ("Under the authors' settings, ours", theirs))
                           if c is not None and not c["holds"])
         runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
-        b.add(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
+        b.add(RowSpec(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
               where=first.where, thesis=f"the authors' curve ({first.kind})",
               ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],
               rule="curve-band", kind="whole curve", page=page, heading=heading,
               ours_value=None if ours is None else ours["share"],
               seeds=None if ours is None else ours["seeds"], interval_text="" if ours is None else ours["band"],
-              authors_output=f"their {runs} runs" if runs > 1 else "their curve", authors_output_source=first.source,
+              output=Output(value=None, text=f"their {runs} runs" if runs > 1 else "their curve", source=first.source),
               fields={"figure": figure, "curve": curve, "experiment": None if ours is None else first.experiment},
-              remark=remark, **authors)
+              remark=remark, authors=authors))

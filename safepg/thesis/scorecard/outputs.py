@@ -33,10 +33,6 @@ class Output:
     complete: bool = True
     iterations: int | None = None
 
-    def cells(self) -> dict[str, Any]:
-        """The :class:`~safepg.thesis.scorecard.rules.Row` fields of this output."""
-        return {"authors_output": self.text, "authors_output_value": self.value, "authors_output_source": self.source}
-
 
 def source(src: Mapping[str, Any], runs: int = 1) -> str:
     """``path@commit`` (seven hex digits) of a manifest source; ``runs`` > 1 writes the sample

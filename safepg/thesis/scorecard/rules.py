@@ -13,9 +13,11 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
+
+from safepg.thesis.scorecard.text import MissingValueError, fill, template_fields
 
 #: The status of a row that fails its rule on our runs of the thesis's text and passes it, by the
 #: same rule, on our runs under the authors' settings: what their code ran where the text says
@@ -145,14 +147,110 @@ STATUS_RULE = ("A row is judged first on \"ours\": our runs as the thesis's text
                "row names the slip between their output and the print, with both numbers.")
 
 
+# ------------------------------------------------------------------ the notes' measured values
+# Each note that quotes measured values declares them as one of these: a row gives its note an
+# instance, so that a value left out fails where the row is built, not on the page.
+class Theta0s(NamedTuple):
+    """Table 5.1's two starting points, as the notes quote them."""
+
+    printed_theta0: str
+    authors_theta0: str
+
+
+class RangeRuns(NamedTuple):
+    """Table 5.2's theoretical-range row under Lemma 4.3.3's range and under the authors' settings."""
+
+    range_rows: str
+
+
+class PrintedDiscount(NamedTuple):
+    """The 2-D LQG's theta* at the printed discount (0.95)."""
+
+    theta_printed_setting: float
+
+
+class ClosedFormJ(NamedTuple):
+    """The 2-D LQG's J(theta*): at the discount the runs use (0.9) and at the printed one (0.95)."""
+
+    J_used: float
+    J_printed_setting: float
+
+
+class FinalTheta(NamedTuple):
+    """One entry of the 2-D runs' final theta: the authors' run and the range of our seeds."""
+
+    authors_output: str
+    seeds: str
+
+
+class BatchSizes(NamedTuple):
+    """The adaptive batch size of the 2-D runs: ours, the authors' run, ours under their settings."""
+
+    ours: float
+    authors_output: str
+    authors_settings: str
+
+
+class AuthorsBaseline(NamedTuple):
+    """The cart-pole baseline's iteration count on the authors' task."""
+
+    authors_baseline: str
+
+
+class CertifiedSteps(NamedTuple):
+    """The range of the steps Theorem 4.2.3 certifies on the cart-pole task."""
+
+    adaptive_steps: str
+
+
+class MovedComponents(NamedTuple):
+    """The cart-pole components that ours moves although the thesis says they never move."""
+
+    extra: str
+    extra_move: float
+    authors_components: str
+
+
 @dataclass(frozen=True)
 class Note:
-    """Why a row differs (``explains=True``) or what is known about an open row."""
+    """Why a row differs (``explains=True``) or what is known about an open row.
+
+    ``measured``: the NamedTuple of the values its ``{...}`` fields name (None: it names none).
+
+    Raises
+    ------
+    MissingValueError
+        If ``text`` names a field that ``measured`` does not declare.
+    """
 
     text: str
     page: str
     heading: str
     explains: bool = True
+    measured: type[tuple[Any, ...]] | None = None
+
+    def __post_init__(self) -> None:
+        declared = set(getattr(self.measured, "_fields", ()))
+        missing = template_fields(self.text) - declared
+        if missing:
+            raise MissingValueError(f"the note {self.text[:60]!r}... names {sorted(missing)}, which its measured "
+                                    f"values {sorted(declared)} do not declare")
+
+    def fill(self, values: tuple[Any, ...] | None) -> str:
+        """The note's text filled from ``values``, an instance of :attr:`measured`.
+
+        Raises
+        ------
+        MissingValueError
+            If the note names values and ``values`` is not its :attr:`measured` (None: none given).
+        """
+        if self.measured is None:
+            if values is not None:
+                raise TypeError(f"the note {self.text[:60]!r}... quotes no values, got {values!r}")
+            return self.text
+        if not isinstance(values, self.measured):
+            raise MissingValueError(f"the note {self.text[:60]!r}... needs a {self.measured.__name__}, got {values!r}")
+        return fill(self.text, values._asdict())  # type: ignore[attr-defined]
 
 
 #: The authors' curves of Figures 5.1 and 5.2 that leave our band.
@@ -164,55 +262,60 @@ _FIGURES_5_1_5_2 = Note(
     "method.", "lqg1d", "Figures 5.1 and 5.2", explains=False)
 
 #: Explanations and notes, by row id or id prefix (``"table-5.1/"`` covers every cell).
-#: ``{...}`` fields are filled from the measured values (see :func:`safepg.thesis.scorecard.text.fill`).
+#: ``{...}`` fields are filled from the note's measured values, which the row gives (:meth:`Note.fill`).
 NOTES: dict[str, Note] = {
     "table-5.1/": Note(
-        "Open: neither from the printed θ0 = {t51_theta0} nor from the authors' θ0 = {t51_authors_theta0} does our "
+        "Open: neither from the printed θ0 = {printed_theta0} nor from the authors' θ0 = {authors_theta0} does our "
         "prediction interval for one run hold the printed value; what is missing: the authors' other runs (one run "
-        "per cell is committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False),
+        "per cell is committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False,
+        measured=Theta0s),
     "table-5.2/theoretical-range": Note(
         "Open: {range_rows}, and the authors' own five runs give the printed value (beside). What is missing is "
-        "a setting of theirs that accounts for the rest.", "lqg1d", "Table 5.2", explains=False),
+        "a setting of theirs that accounts for the rest.", "lqg1d", "Table 5.2", explains=False,
+        measured=RangeRuns),
     "section-5.2/theta-star": Note(
         "Reproduced with γ = 0.9, the discount the Section 5.2 runs use and the only one in the authors' code "
         "(lqgnd/lqgnd.py@92ac378:41); the printed γ = 0.95 gives {theta_printed_setting:.4f}.", "lqg2d",
-        "setting as printed"),
+        "setting as printed", measured=PrintedDiscount),
     "section-5.2/J-star": Note(
         "Not reproducible by the consistent closed form: it gives {J_used:.3f} at θ* (γ = 0.9) and "
-        "{J_printed_setting:.3f} for the printed γ = 0.95.", "lqg2d", "lab library"),
+        "{J_printed_setting:.3f} for the printed γ = 0.95.", "lqg2d", "lab library", measured=ClosedFormJ),
     "section-5.2/theta-final-scalar/11": Note(
-        "Ours end near the authors' own run ({authors_theta_scalar_11}; our seeds {seeds_theta_scalar_11}), one "
-        "digit away from the print: the print slipped.", "lqg2d", "Figures 5.5 and 5.6"),
+        "Ours end near the authors' own run ({authors_output}; our seeds {seeds}), one digit away from the print: "
+        "the print slipped.", "lqg2d", "Figures 5.5 and 5.6", measured=FinalTheta),
     "section-5.2/theta-final-scalar/22": Note(
-        "Open: the authors' one committed run ends at {authors_theta_scalar_22}, as printed; our five seeds end at "
-        "{seeds_theta_scalar_22}, about 2e-5 nearer 0 (θ11 likewise). What is missing: their other runs, to tell "
-        "a setting from one run's noise.", "lqg2d", "Figures 5.5 and 5.6", explains=False),
+        "Open: the authors' one committed run ends at {authors_output}, as printed; our five seeds end at "
+        "{seeds}, about 2e-5 nearer 0 (θ11 likewise). What is missing: their other runs, to tell a setting from "
+        "one run's noise.", "lqg2d", "Figures 5.5 and 5.6", explains=False, measured=FinalTheta),
     "section-5.2/batch-first": Note(
-        "Open: our adaptive batch size starts at {batch_first:.0f} on average over iterations 2-11, the authors' "
-        "own run at {authors_lqg2d_batch_first}, near the printed ≈ 500; under their settings ours is "
-        "{authors_settings_lqg2d_batch_first}. What is missing: the setting that makes their early batches "
-        "larger than ours.", "lqg2d", "Table 5.3", explains=False),
+        "Open: our adaptive batch size starts at {ours:.0f} on average over iterations 2-11, the authors' "
+        "own run at {authors_output}, near the printed ≈ 500; under their settings ours is "
+        "{authors_settings}. What is missing: the setting that makes their early batches larger than ours.",
+        "lqg2d", "Table 5.3", explains=False, measured=BatchSizes),
     "section-5.2/batch-last": Note(
-        "The printed ≈ 2500 is not in the authors' own run either: it averages {authors_lqg2d_batch_last} over "
-        "its last 10 iterations, ours {batch_last:.0f}; the thesis reads its number off Figure 5.7.", "lqg2d",
-        "Table 5.3"),
+        "The printed ≈ 2500 is not in the authors' own run either: it averages {authors_output} over "
+        "its last 10 iterations, ours {ours:.0f}; the thesis reads its number off Figure 5.7.", "lqg2d",
+        "Table 5.3", measured=BatchSizes),
     "table-5.3/adaptive/upsilon": Note(
         "The thesis gives no N_min, nor what happens when Assumption 4.2.7 fails, for this section; ours "
         "(N_min = 100, no update) set the first iterations, which weigh on the average.", "lqg2d", "Table 5.3"),
     "section-5.3/baseline-iterations": Note(
         "The count depends strongly on settings the thesis does not state: with the same protocol, 72 lies "
         "between our counts at γ = 0.99 and γ = 0.995, and the chapter's sweep also reaches it with a 0.01 s "
-        "time step; on the authors' task ours is {authors_baseline}.", "cartpole", "baseline policy"),
+        "time step; on the authors' task ours is {authors_baseline}.", "cartpole", "baseline policy",
+        measured=AuthorsBaseline),
     # The chapter's sweep found the printed result not reproducible under any plausible setting:
     # an explained difference, not an open one.
     "table-5.4/": Note(
         "Not reproducible as the thesis describes the task: the steps Theorem 4.2.3 certifies on it "
         "({adaptive_steps}) leave θ where the baseline left it, and the chapter's sweep over every unstated setting "
-        "finds none where it learns or where vanilla PG oscillates as reported.", "cartpole", "What the sweep says"),
+        "finds none where it learns or where vanilla PG oscillates as reported.", "cartpole", "What the sweep says",
+        measured=CertifiedSteps),
     "section-5.3/components": Note(
         "Open: ours also moves {extra} (by at most {extra_move:.0e}); the thesis's constants, which decide "
         "which component is updated, are not given; under the authors' settings (their per-batch constants) the "
-        "components never updated are {authors_components}.", "cartpole", "Table 5.4", explains=False),
+        "components never updated are {authors_components}.", "cartpole", "Table 5.4", explains=False,
+        measured=MovedComponents),
     "figure-5.1/": _FIGURES_5_1_5_2,
     "figure-5.2/": _FIGURES_5_1_5_2,
     # Errata rows carry their own sentence (safepg.thesis.errata.errata()); this gives their link.

@@ -8,7 +8,8 @@ the authors' own output (:mod:`safepg.thesis.scorecard.outputs`)."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from typing import Any
+from dataclasses import replace
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from safepg.learning import LearningRecord
 from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
 from safepg.thesis.scorecard import outputs
-from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.judged import (
     ci_judged,
     frozen,
@@ -30,6 +31,13 @@ from safepg.thesis.scorecard.rules import (
     FROZEN_THETA,
     PRINTED,
     TABLE_DECIMALS,
+    AuthorsBaseline,
+    BatchSizes,
+    CertifiedSteps,
+    FinalTheta,
+    MovedComponents,
+    RangeRuns,
+    Theta0s,
     half_unit,
     in_prediction,
     intervals_overlap,
@@ -48,19 +56,20 @@ def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
 
 
 def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[float] | None, text: str,
-             check: Callable[[float, list[float] | None], bool | None], **judged: Any) -> dict[str, Any]:
-    """The ``Builder.add`` arguments of ours under the authors' settings: the cell, and the row's
-    rule ``check(mean, ci)`` applied to it when every seed of ``exp`` is stored; ``judged``: the
-    ``authors_interval``, ``authors_interval_text`` and ``authors_vacuous`` of that judgement."""
+             check: Callable[[float, list[float] | None], bool | None], *, interval: list[float] | None = None,
+             interval_text: str = "", vacuous: str = "") -> AuthorsColumn:
+    """Ours under the authors' settings: the cell, and the row's rule ``check(mean, ci)`` applied to it
+    when every seed of ``exp`` is stored, with the ``interval``, ``interval_text`` and ``vacuous`` of
+    that judgement."""
     if exp is None:
-        return {}
-    cells: dict[str, Any] = {"authors_experiment": exp.name, "authors_seeds": seeds}
+        return AuthorsColumn()
+    column = AuthorsColumn(experiment=exp.name, seeds=seeds, text="-")
     if mean is None or seeds == 0:
-        return {**cells, "authors": "-"}
-    cells.update(authors_value=mean, authors_ci95=ci)
+        return column
+    column = replace(column, value=mean, ci95=ci, text=text)
     if seeds < exp.seeds:  # a partly computed campaign is shown, not judged
-        return {**cells, "authors": f"{text} ({seeds} of {exp.seeds} seeds: not judged)"}
-    return {**cells, "authors": text, "authors_ok": check(mean, ci), **judged}
+        return replace(column, text=f"{text} ({seeds} of {exp.seeds} seeds: not judged)")
+    return replace(column, ok=check(mean, ci), interval=interval, interval_text=interval_text, vacuous=vacuous)
 
 
 def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
@@ -72,10 +81,9 @@ def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale
             f"({out.source}), the thesis prints {show(float(printed))}.")
 
 
-def _said(cells: Mapping[str, Any]) -> str:
+def _said(column: AuthorsColumn) -> str:
     """Ours under the authors' settings as a note quotes it."""
-    text = cells.get("authors", "-")
-    return "(not stored yet)" if text == "-" else text
+    return "(not stored yet)" if not column.experiment or column.text == "-" else column.text
 
 
 def _report_row(rep: Mapping[str, Any] | None, name: str) -> Mapping[str, Any] | None:
@@ -94,7 +102,7 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
     recon = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(exp.configs, rep["configs"])}
     theirs = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(authors.configs if authors else (),
                                                                    (authors_rep or {}).get("configs", []))}
-    b.values.update(t51_theta0=f"{T51_PRINTED_THETA0:g}", t51_authors_theta0=f"{AUTHORS_T51_THETA0:g}")
+    starts = Theta0s(printed_theta0=f"{T51_PRINTED_THETA0:g}", authors_theta0=f"{AUTHORS_T51_THETA0:g}")
     for c, r in zip(printed.configs, printed_rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
         if thesis is None:
@@ -104,11 +112,11 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
         ok = None if mean is None else one_run_ratio(thesis, r)
         ar = theirs.get(key)
         a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
-        a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                           pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
-                           lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
-                           authors_interval=ratio_interval(ar), authors_interval_text=ratio_text(ar),
-                           authors_vacuous=frozen(ar and ar.get("theta_moved")))
+        a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                         pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
+                         lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
+                         interval=ratio_interval(ar), interval_text=ratio_text(ar),
+                         vacuous=frozen(ar and ar.get("theta_moved")))
         rc = recon.get(key)
         rc_mean = None if rc is None else rc["improvement_ratio"]["mean"]
         recon_text = "" if rc_mean is None else \
@@ -116,7 +124,7 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
              f"gives {pct(rc_mean)}.")
         out = outputs.table_5_1(*key)
         printed_text = f"{100 * thesis:.6g}"
-        b.add(id=f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}", group="Section 5.1",
+        b.add(RowSpec(id=f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}", group="Section 5.1",
               quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, α = {c.alpha:.0e}", where="Table 5.1",
               thesis=pct(thesis),
               ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
@@ -124,13 +132,13 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
               rule="prediction", kind="one run", page="lqg1d", heading="Table 5.1", thesis_value=thesis,
               ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds,
               interval=ratio_interval(r), interval_text=ratio_text(r), vacuous=frozen(r.get("theta_moved")),
-              authors_note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} the printed value is outside our "
-                           f"prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} (where all "
-                           "24 of their output files start), counted as they counted (strict increases over 10^6/N - 1 "
-                           "updates), it is inside." + recon_text,
+              authors=replace(a_col, note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} the printed value is outside "
+                              f"our prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} "
+                              "(where all 24 of their output files start), counted as they counted (strict increases "
+                              "over 10^6/N - 1 updates), it is inside." + recon_text),
               slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
               fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": c.theta0[0]},
-              **a_cells, **out.cells())
+              output=out, note_values=starts))
 
 
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
@@ -159,7 +167,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         else:
             ratios.append(r["improvement_ratio"]["mean"])
         out = outputs.table_5_2(key)
-        seeds, a_cells, note_id, guarded = r["seeds"], {}, None, ""
+        seeds, a_col, note_id, guarded, range_runs = r["seeds"], AuthorsColumn(), None, "", None
         theoretical = c.bound != "chebyshev" and not c.empirical_range and key in lemma
         if theoretical:
             vc, vr = lemma[key]
@@ -167,25 +175,24 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             ar = _report_row(authors_rep, c.name) if authors is not None else None
             if authors is not None:
                 a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
-                a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                                   f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
-                                   lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                   authors_interval=a_ci,
-                                   authors_interval_text=ci_judged(a_ci, fmt, ar and ar["seeds"]))
+                a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
+                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
+                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar and ar["seeds"]))
             else:
-                a_cells = _authors(exp, seeds, mean, ci, guarded,
-                                   lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                   authors_interval=ci, authors_interval_text=ci_judged(ci, fmt, seeds))
+                a_col = _authors(exp, seeds, mean, ci, guarded,
+                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
+                                 interval=ci, interval_text=ci_judged(ci, fmt, seeds))
             mean, ci = _mean_ci(vr["upsilon_bar"])
             seeds = vr["seeds"]
-            b.values["range_rows"] = (f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
-                                      f"authors' settings {a_cells.get('authors', '-')} over "
-                                      f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
+            range_runs = RangeRuns(f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
+                                   f"authors' settings {a_col.text or '-'} over "
+                                   f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
         ok = None if mean is None else intervals_overlap(ci, th["ci95"])
         er = " (e.r.)" if c.empirical_range else ""
         label = f"{c.estimator}-{c.bound}{'-er' if c.empirical_range else ''}-delta={c.delta:g}"
-        b.add(id=f"table-5.2/{label}", group="Section 5.1",
+        b.add(RowSpec(id=f"table-5.2/{label}", group="Section 5.1",
               quantity=f"average performance, {'REINFORCE' if c.estimator == 'reinforce' else 'G(PO)MDP'}, "
               f"{c.bound.capitalize()}{er}, δ = {c.delta:g}", where="Table 5.2",
               thesis=f"{fmt(th['upsilon_bar'])}{ci_text(th['ci95'], fmt)}", ours=f"{fmt(mean)}{ci_text(ci, fmt)}",
@@ -193,26 +200,27 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
               kind="mean of runs", page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"],
               ours_value=mean, ours_ci95=ci, seeds=seeds, expected_seeds=exp.seeds, interval=ci,
               interval_text=ci_judged(ci, fmt, seeds),
-              authors_note=("Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the "
-                            "authors' settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) "
-                            "= 1280 (lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
-                            f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
-                            f"their range and our guarded step (table-5.2): {guarded}.") if guarded else "",
+              authors=replace(a_col, note=(
+                  "Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the authors' "
+                  "settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) = 1280 "
+                  "(lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
+                  f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
+                  f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
               slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
               fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
                       "delta": c.delta, "theoretical_range": None if theoretical else c.theoretical_range,
-                      "thesis_ci95": list(th["ci95"])}, **a_cells, **out.cells())
+                      "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
     complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
     got = [x for x in ratios if x is not None] if complete else []
     low = min(got) if got else None
-    b.add(id="section-5.1/improvement-ratio-adaptive", group="Section 5.1",
+    b.add(RowSpec(id="section-5.1/improvement-ratio-adaptive", group="Section 5.1",
           quantity="improvement ratio of Algorithm 4.1, every Table 5.2 configuration whose θ moves (lowest)",
           where="Section 5.1, after Table 5.2", thesis="100%", ours=pct(low),
           difference="-" if low is None else f"{100 * (low - 1):+.2f} points",
           ok=None if low is None or len(got) < len(ratios) else within_points(low, 1.0), rule="ratio-points",
           kind="statement", page="lqg1d", heading="Table 5.2", thesis_value=1.0, ours_value=low,
-          remark=f"Left out, θ frozen (moving by less than {FROZEN_THETA:g}): {', '.join(still)}." if still else "")
+          remark=f"Left out, θ frozen (moving by less than {FROZEN_THETA:g}): {', '.join(still)}." if still else ""))
 
 
 def _median_steps(recs: Mapping[str, Sequence], names: list[str], seeds: int) -> list[float] | None:
@@ -242,19 +250,19 @@ def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, r
         diff = f"order 10^{order_of_magnitude(value)}"
     else:
         ours, ok, value, diff = "-", None, None, "-"
-    a_cells: dict[str, Any] = {}
+    a_col = AuthorsColumn()
     if authors is not None:
         a_names = [c.name for c in authors.configs]
         got = dict(authors_recs or {})
         a_med = _median_steps(got, a_names, 1)
         n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
-        a_cells = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
-                           f"median {np.median(a_med):.1e}" if a_med else "-",
-                           lambda *_: all(order_of_magnitude(m) == k for m in a_med))  # type: ignore[union-attr]
-    b.add(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{k}", ours=ours,
+        a_col = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
+                         f"median {np.median(a_med):.1e}" if a_med else "-",
+                         lambda *_: all(order_of_magnitude(m) == k for m in a_med))  # type: ignore[union-attr]
+    b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{k}", ours=ours,
           difference=diff, ok=ok, rule="order", kind="read off a figure", page=page, heading=heading,
           thesis_value=10.0**k, ours_value=value, interval_text="reading precision: an order of magnitude",
-          authors_note=authors_note, **a_cells, **(output.cells() if output else {}))
+          authors=replace(a_col, note=authors_note), output=output))
 
 
 def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
@@ -265,7 +273,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
-            b.add(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", **out.cells(),
+            b.add(RowSpec(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", output=out,
                   quantity=f"improvement ratio, {label}, N = {c.batch_size}", where="Section 5.2.1 (Figure 5.5)",
                   thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
@@ -274,7 +282,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   rule="prediction", kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6",
                   thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
                   expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
-                  vacuous=frozen(r.get("theta_moved")))
+                  vacuous=frozen(r.get("theta_moved"))))
         if "theta_final" in th:
             printed = np.asarray(th["theta_final"], dtype=float)
             finals = np.array([rec.theta_final.reshape(printed.shape) for rec in recs.get(c.name, [])])
@@ -286,10 +294,9 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                 pi = prediction_interval95(seeds)["pi95"] if seeds.size > 1 else None
                 rid = f"section-5.2/theta-final-{c.name}/{i + 1}{j + 1}"
                 out = outputs.lqg2d(c.name, "theta_final", (i, j))
-                b.values[f"authors_theta_{c.name}_{i + 1}{j + 1}"] = out.text
-                if seeds.size:
-                    b.values[f"seeds_theta_{c.name}_{i + 1}{j + 1}"] = f"{seeds.min():.6g} to {seeds.max():.6g}"
-                b.add(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}", **out.cells(),
+                # Without a seed the row is not judged, and its note, which quotes them, not filled.
+                final = FinalTheta(out.text, f"{seeds.min():.6g} to {seeds.max():.6g}") if seeds.size else None
+                b.add(RowSpec(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}", output=out,
                       slip_note=_slip(out, text, lambda v: f"{v:.6g}"),
                       where="Section 5.2.1 (after Figure 5.5)", thesis=text,
                       ours="-" if mean is None else
@@ -300,17 +307,19 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                       ours_value=mean, seeds=int(seeds.size), expected_seeds=exp.seeds, interval=pi,
                       interval_text="every seed exactly 0" if p == 0 else pi_text(pi, lambda v: f"{v:.6g}",
                                                                                    int(seeds.size)),
-                      fields={"step": c.name, "entry": f"{i + 1}{j + 1}"})
+                      fields={"step": c.name, "entry": f"{i + 1}{j + 1}"}, note_values=final))
 
 
 def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[str, Any], page: str,
                         heading: str, group: str, authors: Experiment | None = None,
                         authors_rep: Mapping[str, Any] | None = None,
                         output: Callable[[str, str], outputs.Output] | None = None, authors_note: str = "",
-                        also: tuple[Experiment, Mapping[str, Any]] | None = None) -> None:
+                        also: tuple[Experiment, Mapping[str, Any]] | None = None,
+                        note_values: NamedTuple | None = None) -> None:
     """Average performance and improvement ratio of each method of Table 5.3 or 5.4: ours, ours under
     the authors' settings (``authors``, matched by config name) and ``output(config, quantity)``;
-    ``also``: another run of the authors' settings, quoted in the row's explanation."""
+    ``also``: another run of the authors' settings, quoted in the row's explanation; ``note_values``:
+    the values the table's note quotes."""
     dec = TABLE_DECIMALS[table]
     fmt = lambda x: num(x, dec)  # noqa: E731
     for c, r in zip(exp.configs, rep["configs"]):
@@ -323,32 +332,33 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
             mean, ci = _mean_ci(r["upsilon_bar"])
             pi, a_pi = prediction(r["upsilon_bar"]), prediction(ar and ar["upsilon_bar"])
             a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
-            a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
-                               lambda *_, t=text, i=a_pi: in_prediction(t, i), authors_interval=a_pi,
-                               authors_interval_text=pi_text(a_pi, fmt, ar and ar["seeds"]))
+            a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
+                             lambda *_, t=text, i=a_pi: in_prediction(t, i), interval=a_pi,
+                             interval_text=pi_text(a_pi, fmt, ar and ar["seeds"]))
             out = output(c.name, "upsilon_bar") if output else None
-            b.add(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
+            b.add(RowSpec(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(pi, fmt)}",
                   difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec),
                   ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
                   page=page, heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
                   interval=pi, interval_text=pi_text(pi, fmt, r["seeds"]),
-                  authors_note=authors_note, slip_note="" if out is None else _slip(out, text, fmt),
+                  authors=replace(a_col, note=authors_note), slip_note="" if out is None else _slip(out, text, fmt),
                   remark=_missing(out) or _also(also, other, "upsilon_bar", fmt, text),
-                  **a_cells, **(out.cells() if out else {}))
+                  output=out, note_values=note_values))
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             thesis = th["improvement_ratio"]
             a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
-            a_cells = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                               pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True),
-                                                     lambda x: pct(x, 1)),
-                               lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
-                               authors_interval=ratio_interval(ar), authors_interval_text=ratio_text(ar),
-                               authors_vacuous=frozen(ar and ar.get("theta_moved")))
+            a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+                             pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True),
+                                                   lambda x: pct(x, 1)),
+                             lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
+                             interval=ratio_interval(ar), interval_text=ratio_text(ar),
+                             vacuous=frozen(ar and ar.get("theta_moved")))
             out = output(c.name, "improvement_ratio") if output else None
-            b.add(id=f"{table}/{c.name}/improvement-ratio", group=group, quantity=f"improvement ratio, {method}",
+            b.add(RowSpec(id=f"{table}/{c.name}/improvement-ratio", group=group,
+                  quantity=f"improvement ratio, {method}",
                   where=table.replace("table-", "Table "), thesis=pct(thesis),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
@@ -356,10 +366,11 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   kind="one run", page=page, heading=heading, thesis_value=thesis, ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
                   vacuous=frozen(r.get("theta_moved")),
-                  fields={"method": c.name, "quantity": "improvement_ratio"}, authors_note=authors_note,
+                  fields={"method": c.name, "quantity": "improvement_ratio"},
+                  authors=replace(a_col, note=authors_note),
                   slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
                   remark=_missing(out) or _also(also, other, "improvement_ratio", pct, f"{100 * thesis:.6g}", 100),
-                  **a_cells, **(out.cells() if out else {}))
+                  output=out, note_values=note_values))
 
 
 def _also(also: tuple[Experiment, Mapping[str, Any]] | None, row: Mapping[str, Any] | None, key: str,
@@ -408,8 +419,6 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
                           authors: Experiment | None, authors_recs: Mapping[str, Sequence[LearningRecord]]) -> None:
     first, last = _batch_means(recs.get("adaptive", []))
     a_first, a_last = _batch_means(authors_recs.get("adaptive", []))
-    b.values.update(batch_first=float(np.mean(first)) if first else float("nan"),
-                    batch_last=float(np.mean(last)) if last else float("nan"))
     note = ("Reproduced with the authors' adaptive run: Bernstein on the largest variance and range over the "
             "components and N_max = 100000 (lqgnd/lqgnd_adabatch.py@92ac378:256-257), the step taken even when "
             "ε ≥ abs(g_k).")
@@ -420,23 +429,23 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
         printed = PRINTED[key]
         mean = float(np.mean(vals)) if vals else None
         out = outputs.lqg2d("adaptive", key.replace("lqg2d_", ""))
-        b.values[f"authors_{key}"] = out.text
         a_mean = float(np.mean(a_vals)) if a_vals else None
         pi, a_pi = prediction_interval95(vals)["pi95"], prediction_interval95(a_vals)["pi95"]
         reading = f"the print read to ± {half_unit(printed):g}"
-        a_cells = _authors(authors, len(a_vals), a_mean, None,
-                           "-" if a_mean is None else f"{a_mean:.0f} (seeds {min(a_vals):.0f} to {max(a_vals):.0f})",
-                           lambda *_, i=a_pi, t=printed: in_prediction(t, i), authors_interval=a_pi,
-                           authors_interval_text=pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading))
-        b.values[f"authors_settings_{key}"] = _said(a_cells)
-        b.add(id=rid, group="Section 5.2", quantity=q, where="Section 5.2.1 (Figure 5.7)", thesis=f"≈ {printed}",
+        a_col = _authors(authors, len(a_vals), a_mean, None,
+                         "-" if a_mean is None else f"{a_mean:.0f} (seeds {min(a_vals):.0f} to {max(a_vals):.0f})",
+                         lambda *_, i=a_pi, t=printed: in_prediction(t, i), interval=a_pi,
+                         interval_text=pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading))
+        sizes = None if mean is None else BatchSizes(mean, out.text, _said(a_col))
+        b.add(RowSpec(id=rid, group="Section 5.2", quantity=q, where="Section 5.2.1 (Figure 5.7)",
+              thesis=f"≈ {printed}",
               ours="-" if mean is None else f"{mean:.0f} (seeds {min(vals):.0f} to {max(vals):.0f})",
               difference="-" if mean is None else f"{mean - float(printed):+.0f}",
               ok=None if mean is None else in_prediction(printed, pi), rule="reading", kind="read off a figure",
               page="lqg2d", heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
               interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
-              expected_seeds=seeds, authors_note=note, slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"),
-              **a_cells, **out.cells())
+              expected_seeds=seeds, authors=replace(a_col, note=note),
+              slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
                k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
@@ -466,12 +475,11 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
         mean = float(np.mean(its)) if its else None
         a_mean = float(np.mean(a_its)) if a_its else None
         pi, a_pi = prediction_interval95(its)["pi95"], prediction_interval95(a_its)["pi95"]
-        a_cells = _authors(a_base, len(a_its), a_mean, None,
-                           "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
-                           lambda *_, i=a_pi, t=text: in_prediction(t, i), authors_interval=a_pi,
-                           authors_interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
-        b.values["authors_baseline"] = _said(a_cells)
-        b.add(id="section-5.3/baseline-iterations", group="Section 5.3",
+        a_col = _authors(a_base, len(a_its), a_mean, None,
+                         "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
+                         lambda *_, i=a_pi, t=text: in_prediction(t, i), interval=a_pi,
+                         interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
+        b.add(RowSpec(id="section-5.3/baseline-iterations", group="Section 5.3",
               quantity=f"iterations of the baseline (N = {c.batch_size}, α = {c.alpha:g}) to reach "
               f"{c.target_return:g}", where="Section 5.3", thesis=text,
               ours="-" if mean is None else f"{mean:.1f} (seeds {min(its):.0f} to {max(its):.0f})",
@@ -479,46 +487,50 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
               ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
               page="cartpole", heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean,
               seeds=len(its), interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.1f}", len(its)),
-              expected_seeds=base_exp.seeds, **a_cells, **outputs.cartpole("baseline", "iterations").cells(),
-              authors_note="Reproduced on the authors' task: gym's 12° termination (cartpole/cartpole.py@b9588b7:42; "
-                           "the thesis prints 41.8°), the undiscounted return (cartpole/polgrad.py@aadbf5b:178), and "
-                           "the update of the batch that reaches 195 kept.")
+              expected_seeds=base_exp.seeds, output=outputs.cartpole("baseline", "iterations"),
+              authors=replace(a_col, note="Reproduced on the authors' task: gym's 12° termination "
+                              "(cartpole/cartpole.py@b9588b7:42; the thesis prints 41.8°), the undiscounted return "
+                              "(cartpole/polgrad.py@aadbf5b:178), and the update of the batch that reaches 195 kept."),
+              note_values=AuthorsBaseline(_said(a_col))))
     adaptive = recs54.get("adaptive", [])
     steps = np.concatenate([r.alpha[r.alpha > 0] for r in adaptive] or [np.empty(0)])
-    b.values["adaptive_steps"] = f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none"
+    certified = CertifiedSteps(f"{steps.min():.1e} to {steps.max():.1e}" if steps.size else "none")
     never = PRINTED["cartpole_components_never_updated"]
     updated = None
     for r in rep54["configs"]:
         if r["name"] == "adaptive" and r["seeds"] == exp54.seeds:  # the whole campaign only
             updated = r["components_updated"]
+    extra_text, extra_move = "", 0.0
     if updated is not None:
         extra = [i for i in updated if i in never]
-        b.values["extra"] = ", ".join(_STATE[i] for i in extra) or "nothing else"
+        extra_text = ", ".join(_STATE[i] for i in extra) or "nothing else"
         moves = [np.abs(r.theta_final - r.theta[0])[extra] for r in adaptive]
-        b.values["extra_move"] = float(np.max(moves)) if extra and moves else 0.0
+        extra_move = float(np.max(moves)) if extra and moves else 0.0
     a54 = exps.get(T54_AUTHORS)
     a_row = _report_row(reps.get(T54_AUTHORS), "adaptive")
     a_updated = a_row["components_updated"] if a_row and a_row["seeds"] else None
-    a_cells = _authors(a54, a_row["seeds"] if a_row else 0, None if a_updated is None else 0.0, None,
-                       "-" if a_updated is None else ", ".join(_STATE[i] for i in range(4) if i not in a_updated),
-                       lambda *_: not set(a_updated or ()) & set(never))
+    a_col = _authors(a54, a_row["seeds"] if a_row else 0, None if a_updated is None else 0.0, None,
+                     "-" if a_updated is None else ", ".join(_STATE[i] for i in range(4) if i not in a_updated),
+                     lambda *_: not set(a_updated or ()) & set(never))
     theirs = outputs.cartpole_components_updated()
-    b.values["authors_components"] = _said(a_cells)
-    b.add(id="section-5.3/components", group="Section 5.3",
+    # Without the whole campaign the row is not judged, and its note, which quotes what ours moves, not filled.
+    moved = None if updated is None else MovedComponents(extra_text, extra_move, _said(a_col))
+    b.add(RowSpec(id="section-5.3/components", group="Section 5.3",
           quantity="components of θ the adaptive method never updates", where="Section 5.3, after Table 5.4",
           thesis=", ".join(_STATE[i] for i in never),
           ours="-" if updated is None else ", ".join(_STATE[i] for i in range(4) if i not in updated) or "none",
           difference="-" if updated is None else
-          ("none" if not set(updated) & set(never) else "also updates " + b.values["extra"]),
+          ("none" if not set(updated) & set(never) else "also updates " + extra_text),
           ok=None if updated is None else not set(updated) & set(never), rule="set", kind="one run",
           page="cartpole", heading="Table 5.4",
           vacuous=frozen((_report_row(rep54, "adaptive") or {}).get("theta_moved")),
-          **{**a_cells, "authors_value": None},
-          authors_output=", ".join(_STATE[i] for i in range(4) if i not in theirs),
-          authors_output_source=outputs.cartpole("adaptive", "upsilon_bar").source,
-          authors_note="Reproduced with the authors' adaptive run (their doubled pole at 12°, undiscounted, "
-                       "γ = 0.9 and R, M_φ measured per batch in c, the maxima over components, unguarded "
-                       "steps): only x and dx/dt move, as in their own run.")
+          # A set has no value: the 0.0 given to _authors only marks the column as measured.
+          authors=replace(a_col, value=None, note="Reproduced with the authors' adaptive run (their doubled pole at "
+                          "12°, undiscounted, γ = 0.9 and R, M_φ measured per batch in c, the maxima over components, "
+                          "unguarded steps): only x and dx/dt move, as in their own run."),
+          output=outputs.Output(value=None, text=", ".join(_STATE[i] for i in range(4) if i not in theirs),
+                                source=outputs.cartpole("adaptive", "upsilon_bar").source),
+          note_values=moved))
     _upsilon_table_rows(b, "table-5.4", exp54, rep54, "cartpole", "Table 5.4", "Section 5.3", a54,
                         reps.get(T54_AUTHORS), _t54_output,
                         authors_note="Reproduced on the authors' task and methods, from our runs of their "
@@ -528,7 +540,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
                                      "largest component; both averaged over 1151669 trajectories as "
                                      "plot_cartpole.m@54d92b0 does.",
                         also=(exps[T54_AUTHORS_THETA_STAR], reps[T54_AUTHORS_THETA_STAR])
-                        if T54_AUTHORS_THETA_STAR in exps else None)
+                        if T54_AUTHORS_THETA_STAR in exps else None, note_values=certified)
 
 
 def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapping[str, Any]],

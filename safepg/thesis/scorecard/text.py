@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import string
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -49,10 +50,28 @@ def expr_tex(e: Any) -> str:
     return str(e) if "\\" in str(e) else ""
 
 
+class MissingValueError(KeyError):
+    """A note's text names a field its values do not give."""
+
+
+def template_fields(template: str) -> frozenset[str]:
+    """The names of a note's ``{...}`` fields (``"{J_used:.3f}"`` names ``J_used``)."""
+    # The field's name is what precedes any attribute, index, conversion or format spec.
+    return frozenset(re.split(r"[.\[]", name, maxsplit=1)[0]
+                     for _, name, _, _ in string.Formatter().parse(template) if name is not None)
+
+
 def fill(template: str, values: Mapping[str, Any]) -> str:
-    """A note's text with its ``{...}`` fields filled from ``values``; a field that cannot be
-    filled makes every field read "(not computed)"."""
-    try:
-        return template.format(**values)
-    except (KeyError, ValueError, IndexError):
-        return re.sub(r"\{[^}]*\}", "(not computed)", template)
+    """A note's text with its ``{...}`` fields filled from ``values``.
+
+    Raises
+    ------
+    MissingValueError
+        If ``template`` names a field that ``values`` does not give: a row whose value is
+        legitimately absent (runs not in the store) says so by its own sentence, never by a
+        note left unfilled.
+    """
+    missing = template_fields(template) - set(values)
+    if missing:
+        raise MissingValueError(f"the note {template[:60]!r}... needs {sorted(missing)}, got {sorted(values)}")
+    return template.format(**values)
