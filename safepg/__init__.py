@@ -41,7 +41,7 @@ from safepg.bounds import ErrorBound, error_bound
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.estimators import gpomdp, gradient_samples, reinforce
-from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.learning import LearningRecord, adaptive_pg, learn, vanilla_pg
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -53,18 +53,29 @@ from safepg.meta import (
     scalar_step,
     upsilon,
 )
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.trajectories import Trajectories
 
+#: The package's version.
 __version__ = "0.1.0"
 
 __all__ = [
     "LQG",
+    "Adaptive",
+    "Batches",
+    "Departures",
     "ErrorBound",
+    "ErrorModel",
+    "FixedStep",
+    "Gradient",
     "LearningRecord",
     "LinearGaussianPolicy",
+    "SafeStep",
+    "Target",
     "TaskConstants",
     "Trajectories",
+    "Vanilla",
     "__version__",
     "adaptive_pg",
     "coordinate_step",
@@ -72,6 +83,7 @@ __all__ = [
     "gpomdp",
     "gradient_samples",
     "guaranteed_improvement",
+    "learn",
     "n_star_closed_form",
     "n_star_search",
     "n_zero",

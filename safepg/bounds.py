@@ -20,6 +20,21 @@ from safepg.constants import TaskConstants
 
 Bound = Literal["chebyshev", "hoeffding", "bernstein"]
 BOUNDS: tuple[Bound, ...] = ("chebyshev", "hoeffding", "bernstein")
+#: The gradient's range in Hoeffding's and Bernstein's bounds: ``"lemma"`` (Lemma 4.3.3's
+#: bound), ``"empirical"`` (the batch's max - min) or a number.
+Range = Literal["lemma", "empirical"] | float
+
+
+def check_range(range: Range) -> Range:
+    """Raise ``ValueError("range ...")`` unless ``range`` is "lemma", "empirical" or a finite number > 0."""
+    if isinstance(range, str):
+        if range not in ("lemma", "empirical"):
+            raise ValueError(f"range must be 'lemma', 'empirical' or a finite number > 0, got {range!r}")
+        return range
+    if isinstance(range, bool) or not isinstance(range, int | float | np.floating | np.integer) or not (
+            np.isfinite(range) and range > 0):
+        raise ValueError(f"range must be 'lemma', 'empirical' or a finite number > 0, got {range!r}")
+    return float(range)
 
 
 def check_delta(delta: float) -> float:
@@ -31,7 +46,17 @@ def check_delta(delta: float) -> float:
 
 @dataclass(frozen=True)
 class ErrorBound:
-    """epsilon(N) = d / sqrt(N) + f / N."""
+    r"""A bound on the estimation error as a function of the batch size,
+    :math:`\epsilon(N) = d_\delta/\sqrt N + f_\delta/N` (Assumption 4.3.1).
+
+    Parameters
+    ----------
+    d : float
+        The coefficient of :math:`1/\sqrt N`, >= 0.
+    f : float
+        The coefficient of :math:`1/N`, >= 0 (zero for Chebyshev and Hoeffding, positive for
+        the empirical Bernstein bound).
+    """
 
     d: float
     f: float = 0.0
@@ -49,27 +74,27 @@ class ErrorBound:
         return float(out) if out.ndim == 0 else out
 
 
-def reinforce_variance_factor(k: TaskConstants) -> float:
+def reinforce_variance_factor(constants: TaskConstants) -> float:
     r"""Bound on Var[REINFORCE sample] (Lemma 5.4 of [24], Section 4.3.1).
 
     .. math:: \frac{R^2 M_\phi^2 H (1-\gamma^H)^2}{\sigma^2 (1-\gamma)^2}
     """
-    g, H = k.gamma, k.H
+    gamma, H = constants.gamma, constants.H
     # Powers and logs through safepg.portable: libm's last bit depends on the CPU.
-    root = k.R * k.M_phi * (1 - portable.ipow(g, H)) / (k.sigma * (1 - g))
+    root = constants.R * constants.M_phi * (1 - portable.ipow(gamma, H)) / (constants.sigma * (1 - gamma))
     return root * root * H
 
 
-def gpomdp_variance_factor(k: TaskConstants) -> float:
+def gpomdp_variance_factor(constants: TaskConstants) -> float:
     r"""Bound on Var[G(PO)MDP sample] (Lemma 5.5 of [24], Section 4.3.1).
 
     .. math:: \frac{R^2 M_\phi^2}{\sigma^2(1-\gamma)^2}\Big[\frac{1-\gamma^{2H}}{1-\gamma^2}
               + H\gamma^{2H} - 2\gamma^H\frac{1-\gamma^H}{1-\gamma}\Big]
     """
-    g, H = k.gamma, k.H
-    gH, g2H = portable.ipow(g, H), portable.ipow(g, 2 * H)
-    bracket = (1 - g2H) / (1 - g * g) + H * g2H - 2 * gH * (1 - gH) / (1 - g)
-    root = k.R * k.M_phi / (k.sigma * (1 - g))
+    gamma, H = constants.gamma, constants.H
+    gH, g2H = portable.ipow(gamma, H), portable.ipow(gamma, 2 * H)
+    bracket = (1 - g2H) / (1 - gamma * gamma) + H * g2H - 2 * gH * (1 - gH) / (1 - gamma)
+    root = constants.R * constants.M_phi / (constants.sigma * (1 - gamma))
     return root * root * bracket
 
 
@@ -79,9 +104,10 @@ def chebyshev(delta: float, variance: float) -> ErrorBound:
     return ErrorBound(np.sqrt(variance / delta))
 
 
-def gradient_range_bound(k: TaskConstants) -> float:
+def gradient_range_bound(constants: TaskConstants) -> float:
     r"""Lemma 4.3.3: range of a gradient sample, :math:`2 H M_\phi \bar A R / (\sigma^2 (1-\gamma))`."""
-    return 2 * k.H * k.M_phi * k.A_bar * k.R / (k.sigma * k.sigma * (1 - k.gamma))
+    c = constants
+    return 2 * c.H * c.M_phi * c.A_bar * c.R / (c.sigma * c.sigma * (1 - c.gamma))
 
 
 def hoeffding(delta: float, grad_range: float) -> ErrorBound:
@@ -106,8 +132,7 @@ def error_bound(
     delta: float,
     constants: TaskConstants,
     estimator: str = "gpomdp",
-    empirical_range: bool = False,
-    theoretical_range: float | None = None,
+    range: Range = "lemma",
     variance: float | None = None,
     sample_range: float | None = None,
 ) -> ErrorBound:
@@ -123,11 +148,9 @@ def error_bound(
     constants : TaskConstants
     estimator : {"reinforce", "gpomdp"}
         Chooses the Chebyshev variance bound.
-    empirical_range : bool
-        Hoeffding/Bernstein: use max - min of ``samples`` (the thesis's "e.r.")
-        instead of Lemma 4.3.3's range.
-    theoretical_range : float, optional
-        Replace Lemma 4.3.3's range (used when ``empirical_range`` is False) by this value.
+    range : "lemma", "empirical" or float
+        Hoeffding/Bernstein: the gradient's range is Lemma 4.3.3's bound (``"lemma"``),
+        max - min of ``samples`` (``"empirical"``, the thesis's "e.r.") or the given number.
     variance, sample_range : float, optional
         Use these in place of the sample variance (ddof = 1) and the range max - min of
         ``samples`` (Bernstein; empirical range), e.g. the largest over all components, as
@@ -145,14 +168,12 @@ def error_bound(
         raise ValueError(f"estimator must be 'reinforce' or 'gpomdp', got {estimator!r}")
     if bound not in ("hoeffding", "bernstein"):
         raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
-    if empirical_range:
+    if range == "empirical":
         grad_range = float(np.ptp(samples)) if sample_range is None else float(sample_range)
-    elif theoretical_range is not None:
-        if not (np.isfinite(theoretical_range) and theoretical_range > 0):
-            raise ValueError(f"theoretical_range must be finite and > 0, got {theoretical_range}")
-        grad_range = float(theoretical_range)
-    else:
+    elif range == "lemma":
         grad_range = gradient_range_bound(constants)
+    else:
+        grad_range = check_range(range)
     if bound == "hoeffding":
         return hoeffding(delta, grad_range)
     return bernstein(delta, float(np.var(samples, ddof=1)) if variance is None else float(variance), grad_range)

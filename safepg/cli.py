@@ -18,8 +18,9 @@ import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.options import Batches, ErrorModel, FixedStep, Gradient
 from safepg.store import DamagedRunsError, DamagedRunWarning, results_dir
-from safepg.thesis import experiments
+from safepg.thesis import experiment_store, experiments, report
 
 ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
 
@@ -95,16 +96,16 @@ def _run_learn(args: argparse.Namespace) -> dict:
     theta0 = np.asarray(args.theta0, dtype=float)
     if theta0.size == 1:
         theta0 = np.full(env.dim**2, theta0[0]) * np.eye(env.dim).ravel() if env.dim > 1 else theta0
-    common = dict(estimator=args.estimator, baseline=not args.no_baseline, bound=args.bound,
-                  delta=args.delta, empirical_range=args.empirical_range, budget=args.budget,
-                  score_action=args.score_action, rng=args.seed, progress=not args.quiet)
+    gradient = Gradient(args.estimator, not args.no_baseline, args.score_action)
+    common = dict(gradient=gradient, budget=args.budget, rng=args.seed, progress=not args.quiet)
     if args.fixed_alpha is not None or args.fixed_n is not None:
         if args.fixed_alpha is None or args.fixed_n is None:
             raise ValueError("--fixed-alpha and --fixed-n must be given together for vanilla PG")
-        rec = vanilla_pg(env, theta0, args.sigma, batch_size=args.fixed_n, alpha=args.fixed_alpha,
-                         step=args.step, **common)
+        rec = vanilla_pg(env, theta0, args.sigma, batch_size=args.fixed_n, step=FixedStep(args.fixed_alpha, args.step),
+                         **common)
     else:
-        rec = adaptive_pg(env, theta0, args.sigma, n_min=args.n_min, n_max=args.n_max, **common)
+        error = ErrorModel(args.bound, args.delta, "empirical" if args.empirical_range else "lemma")
+        rec = adaptive_pg(env, theta0, args.sigma, error=error, batches=Batches(args.n_min, args.n_max), **common)
     out = rec.summary()
     out["J_star"] = env.performance(env.optimal_gain(), args.sigma)
     out["theta_star"] = env.optimal_gain().ravel().tolist()
@@ -157,8 +158,8 @@ def _cmd_list(args: argparse.Namespace) -> None:
 
 def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
     exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
-    recs = experiments.run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
-    return experiments.report(exp, recs)
+    recs = experiment_store.run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
+    return report.report(exp, recs)
 
 
 def _cmd_run_book(args: argparse.Namespace) -> None:
@@ -177,7 +178,7 @@ def _cmd_run_book(args: argparse.Namespace) -> None:
 def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
     exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
     try:
-        recs = experiments.load_experiment(exp, on_damaged="raise")
+        recs = experiment_store.load_experiment(exp, on_damaged="raise")
     except DamagedRunsError as err:
         # A report without them would look complete; ``run`` repairs them (set aside, recomputed).
         lines = [f"damaged run file {d.path}: {d.reason}" for d in err.damaged]
@@ -185,7 +186,7 @@ def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:
                      f"repair with: {_run_command(args)} (sets each aside as <file>.damaged-<time> and "
                      "computes its run again)")
         raise DamagedStoreError("\nsafepg: ".join(lines)) from None
-    out = experiments.report(exp, recs)
+    out = report.report(exp, recs)
     # The store is keyed by settings, so "nothing stored" often means other --seeds/--budget.
     stored, total = sum(r["seeds"] for r in out["configs"]), len(exp.configs) * exp.seeds
     if stored == 0:

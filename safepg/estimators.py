@@ -22,6 +22,7 @@ from safepg.trajectories import Trajectories
 Estimator = Literal["reinforce", "gpomdp"]
 ScoreAction = Literal["clipped", "raw"]
 ESTIMATORS: tuple[Estimator, ...] = ("reinforce", "gpomdp")
+SCORE_ACTIONS: tuple[ScoreAction, ...] = ("clipped", "raw")
 
 
 def check_estimator(estimator: str) -> None:

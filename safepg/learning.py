@@ -10,14 +10,14 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any, Literal, Protocol
+from typing import Any
 
 import numpy as np
 from tqdm.auto import tqdm
 
-from safepg.bounds import Bound, ErrorBound, check_delta, error_bound
-from safepg.constants import BoundedTask, TaskConstants
-from safepg.estimators import Estimator, ScoreAction, gradient_samples
+from safepg.bounds import ErrorBound, error_bound
+from safepg.constants import TaskConstants
+from safepg.estimators import gradient_samples
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -25,14 +25,23 @@ from safepg.meta import (
     penalty_constant,
     scalar_step,
 )
+from safepg.options import (
+    Adaptive,
+    Batches,
+    Departures,
+    ErrorModel,
+    FixedStep,
+    Gradient,
+    Method,
+    SafeStep,
+    Target,
+    Vanilla,
+)
 from safepg.policies import LinearGaussianPolicy
 from safepg.record import CHECKPOINTS, LearningRecord, RecordFileError
 from safepg.rng import RNGLike, as_generator
+from safepg.tasks import Hooks, Task, task_hooks
 from safepg.trajectories import Trajectories
-
-
-class Task(BoundedTask, Protocol):
-    def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories: ...
 
 
 @dataclass(frozen=True)
@@ -52,20 +61,18 @@ UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"
 Progress = bool | Callable[[int, int], object]
 
 
-def _closed_form(task: Task, thetas: np.ndarray, sigma: float) -> np.ndarray:
+def _closed_form(hooks: Hooks, thetas: np.ndarray, sigma: float) -> np.ndarray:
     """J(theta_i) for every row of ``thetas``; NaN for a task without a closed form."""
-    batched = getattr(task, "performance_batch", None)
-    if batched is not None:
-        return np.asarray(batched(thetas, sigma), dtype=float)
-    perf = getattr(task, "performance", None)
-    if perf is None:
+    if hooks.performance_batch is not None:
+        return np.asarray(hooks.performance_batch(thetas, sigma), dtype=float)
+    if hooks.performance is None:
         return np.full(len(thetas), np.nan)
-    return np.array([perf(theta, sigma) for theta in thetas], dtype=float)
+    return np.array([hooks.performance(theta, sigma) for theta in thetas], dtype=float)
 
 
 def _collect(
-    task: Task, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator,
-    estimator: Estimator, baseline: bool, score_action: ScoreAction, maxima: bool = False,
+    task: Task, hooks: Hooks, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator, gradient: Gradient,
+    maxima: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, tuple[float, float] | None]:
     """Gradient samples (n, m), measured returns (n,) and, with ``maxima``, the batch's
     measured (R, M_phi) (else None) of a fresh batch.
@@ -77,21 +84,19 @@ def _collect(
     return. With ``maxima``: the task's ``gradient_batch_maxima`` if it has one (the
     cart-pole), else the largest |reward| and |feature| of the simulated batch's live steps.
     """
+    how = (gradient.estimator, gradient.baseline, gradient.score_action)
     if maxima:
-        fused_maxima = getattr(task, "gradient_batch_maxima", None)
-        if fused_maxima is not None:
-            return fused_maxima(policy, n, rng, estimator, baseline, score_action)
-    else:
-        fused = getattr(task, "gradient_batch", None)
-        if fused is not None:
-            return (*fused(policy, n, rng, estimator, baseline, score_action), None)
+        if hooks.gradient_batch_maxima is not None:
+            return hooks.gradient_batch_maxima(policy, n, rng, *how)
+    elif hooks.gradient_batch is not None:
+        return (*hooks.gradient_batch(policy, n, rng, *how), None)
     batch = task.simulate(policy, n, rng)
-    measured = getattr(task, "measured_returns", Trajectories.discounted_returns)
+    measured = hooks.measured_returns or Trajectories.discounted_returns
     found = None
     if maxima:
         live = np.ones(batch.rewards.shape, dtype=bool) if batch.mask is None else batch.mask.astype(bool)
         found = (float(np.abs(batch.rewards[live]).max()), float(np.abs(batch.features[live]).max()))
-    return gradient_samples(policy, batch, estimator, baseline, score_action), measured(batch), found
+    return gradient_samples(policy, batch, *how), measured(batch), found
 
 
 def _check_budget(budget: int, n_first: int) -> None:
@@ -101,19 +106,17 @@ def _check_budget(budget: int, n_first: int) -> None:
 
 def _learn(
     task: Task,
+    hooks: Hooks,
     policy: LinearGaussianPolicy,
     rule: UpdateRule,
     n_first: int,
     budget: int,
     rng: RNGLike,
-    estimator: Estimator,
-    baseline: bool,
-    score_action: ScoreAction,
+    gradient: Gradient,
     config: dict[str, Any],
     progress: Progress,
     stop_on_divergence: bool = False,
-    target_return: float | None = None,
-    update_at_target: bool = False,
+    target: Target | None = None,
     maxima: bool = False,
 ) -> LearningRecord:
     rng = as_generator(rng)
@@ -132,7 +135,7 @@ def _learn(
             n = min(n, budget - used)
             if n < 2:
                 break
-            samples, returns, found = _collect(task, policy, n, rng, estimator, baseline, score_action, maxima)
+            samples, returns, found = _collect(task, hooks, policy, n, rng, gradient, maxima)
             with np.errstate(over="ignore", invalid="ignore"):  # a non-finite mean is handled just below
                 # sum / n is what ndarray.mean computes (same bits), without its Python overhead:
                 # a run with N = 100 has 3*10^5 iterations.
@@ -143,8 +146,8 @@ def _learn(
                     break
                 raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
             J_hat = float(returns.sum() / n)
-            reached = target_return is not None and J_hat >= target_return
-            if reached and not update_at_target:
+            reached = target is not None and J_hat >= target.value
+            if reached and not (target is not None and target.update):
                 # The policy that produced this batch is the result: record the batch, keep theta.
                 up = _Update(np.zeros_like(grad), 0.0, -1, 0.0, True, n)
             else:
@@ -177,7 +180,7 @@ def _learn(
         alpha=np.asarray(rows["alpha"], dtype=float),
         coordinate=np.asarray(rows["coordinate"], dtype=np.int64),
         theta=theta_rows,
-        J=_closed_form(task, theta_rows, policy.sigma),
+        J=_closed_form(hooks, theta_rows, policy.sigma),
         J_hat=np.asarray(rows["J_hat"], dtype=float),
         grad=np.asarray(rows["grad"], dtype=float).reshape(-1, m),
         eps=np.asarray(rows["eps"], dtype=float),
@@ -189,10 +192,9 @@ def _learn(
     )
 
 
-def _initial_policy(task: Task, theta0: np.ndarray | float, sigma: float | np.ndarray) -> LinearGaussianPolicy:
+def _initial_policy(hooks: Hooks, theta0: np.ndarray | float, sigma: float | np.ndarray) -> LinearGaussianPolicy:
     theta0 = np.asarray(theta0, dtype=float)
-    shape = (getattr(task, "action_dim", None) or getattr(task, "dim", 1), None)
-    d_a = shape[0]
+    d_a = hooks.action_dim
     if theta0.ndim <= 1:
         theta0 = np.broadcast_to(theta0, (theta0.size,)) if theta0.ndim == 1 else theta0.reshape(1)
         m = theta0.size
@@ -207,22 +209,13 @@ def adaptive_pg(
     theta0: np.ndarray | float = 0.0,
     sigma: float = 1.0,
     *,
-    estimator: Estimator = "gpomdp",
-    baseline: bool = True,
-    bound: Bound = "chebyshev",
-    delta: float = 0.95,
-    empirical_range: bool = False,
-    theoretical_range: float | None = None,
-    n_min: int = 100,
-    n_max: int = 500_000,
+    gradient: Gradient = Gradient(),
+    error: ErrorModel = ErrorModel(),
+    batches: Batches = Batches(),
+    departures: Departures = Departures(),
     budget: int = 30_000_000,
-    score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
     progress: Progress = False,
-    n_first: int | None = None,
-    constants: Literal["bounds", "batch"] = "bounds",
-    statistics: Literal["component", "max"] = "component",
-    step_when_unsafe: bool = False,
 ) -> LearningRecord:
     r"""Adaptive policy gradient, Algorithm 4.1 (as corrected in the book's errata).
 
@@ -231,90 +224,79 @@ def adaptive_pg(
     :math:`\epsilon = d_\delta/\sqrt N + f_\delta/N` from the chosen bound on component k,
     moves :math:`\theta_k` by the step of Corollary 4.2.8, and sets the next batch size to
     N* (Theorem 4.3.2, or the search of Section 4.3.3 for Bernstein) clipped to
-    [n_min, n_max]. The first batch has n_min trajectories (``n_first`` to change it).
-
-    The last four parameters default to the algorithm as the theorems need it; the other
-    values are what the authors' 2-D and cart-pole scripts did, to reproduce their runs.
+    [n_min, n_max]. The first batch has n_min trajectories (``batches.first`` to change it).
 
     Parameters
     ----------
-    task : environment with ``simulate`` and the bound constants (e.g. :class:`~safepg.envs.LQG`)
-    theta0 : initial parameters (flat vector or gain matrix)
-    sigma : policy standard deviation
-    estimator : "reinforce" or "gpomdp"
-    baseline : use the variance-minimising baseline (else b = 0)
-    bound : "chebyshev", "hoeffding" or "bernstein"
-    delta : probability of a worsening update, in (0, 1)
-    empirical_range : Hoeffding/Bernstein with the batch's max - min instead of Lemma 4.3.3
-    theoretical_range : replaces Lemma 4.3.3's range when ``empirical_range`` is False
-    n_min, n_max : batch-size limits
-    budget : total number of trajectories
-    score_action : "clipped" (the authors' code) or "raw" (unbiased score)
-    rng : seed or Generator
-    progress : True shows a tqdm bar; a callable ``progress(used, budget)`` is called instead
+    task : Task
+        An environment with ``simulate`` and the bound constants (e.g. :class:`~safepg.envs.LQG`);
+        its fast paths (:mod:`safepg.tasks`) are checked when the loop starts.
+    theta0 : ndarray or float
+        Initial parameters (flat vector or gain matrix).
+    sigma : float
+        Policy standard deviation.
+    gradient : Gradient
+        Estimator, baseline and score (:class:`~safepg.options.Gradient`).
+    error : ErrorModel
+        The bound, delta and gradient range (:class:`~safepg.options.ErrorModel`).
+    batches : Batches
+        N_min, N_max and the first batch (:class:`~safepg.options.Batches`).
+    departures : Departures
+        The authors' departures from the algorithm, none by default
+        (:class:`~safepg.options.Departures`).
+    budget : int
+        Total number of trajectories.
+    rng : int, Generator or None
+        Seed or Generator.
+    progress : bool or callable
+        True shows a tqdm bar; a callable ``progress(used, budget)`` is called instead
         after each batch with the trajectories used so far. An exception it raises stops
         the run and propagates to the caller, with no record: how a caller running the loop
         in a thread cancels it (one call per batch, so cancelling waits for one batch).
-    n_first : size of the first batch (None: n_min), which no bound chooses (the authors
-        hard-coded 100 in 2-D and 1000 on the cart-pole)
-    constants : "bounds" (default): R and M_phi are the task's bounds (Assumption 4.2.1), as
-        Theorem 4.2.3 needs; "batch": the largest |reward| and |feature| measured on each batch
-        (the authors' cart-pole script), so the penalty constant and the bounds change from
-        batch to batch; the record's ``config["c"]`` is then the bound-based constant
-    statistics : "component" (default): the sample variance and range of component k, as in
-        Section 4.3.3; "max": the largest sample variance and range over all components (the
-        authors' 2-D and cart-pole scripts)
-    step_when_unsafe : take the step of Corollary 4.2.8's formula even when eps >= |g_k|
-        (the authors' scripts); by default the algorithm does not move then
+
+    Returns
+    -------
+    LearningRecord
+        The per-iteration arrays; ``config`` holds the settings (``config["c"]`` is the
+        penalty constant from the task's bounds).
     """
-    check_delta(delta)
-    if int(n_min) != n_min or n_min < 2:
-        raise ValueError(f"n_min must be an integer >= 2, got {n_min}")
-    if n_min > n_max:
-        raise ValueError(f"n_min must be <= n_max, got n_min={n_min} > n_max={n_max}")
-    if n_first is not None and (int(n_first) != n_first or n_first < 2):
-        raise ValueError(f"n_first must be an integer >= 2 or None, got {n_first}")
-    if constants not in ("bounds", "batch"):
-        raise ValueError(f"constants must be 'bounds' or 'batch', got {constants!r}")
-    if statistics not in ("component", "max"):
-        raise ValueError(f"statistics must be 'component' or 'max', got {statistics!r}")
-    first = n_min if n_first is None else int(n_first)
+    method = Adaptive(gradient, error, batches, departures)  # checks each option's type
+    first = batches.first_size
     _check_budget(budget, first)
-    policy = _initial_policy(task, theta0, sigma)
-    bounds = TaskConstants.from_task(task, policy.sigma)
-    c_bounds = penalty_constant(bounds)
+    hooks = task_hooks(task)
+    policy = _initial_policy(hooks, theta0, sigma)
+    constants = TaskConstants.from_task(task, policy.sigma)
+    c_bounds = penalty_constant(constants)
 
     def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
         g = float(abs(grad[k]))
-        batch_k, c = bounds, c_bounds
-        if found is not None:  # constants="batch": this batch's R and M_phi
-            batch_k = replace(bounds, R=found[0], M_phi=found[1])
-            c = penalty_constant(batch_k)
+        batch_constants, c = constants, c_bounds
+        if found is not None:  # departures.batch_constants: this batch's R and M_phi
+            batch_constants = replace(constants, R=found[0], M_phi=found[1])
+            c = penalty_constant(batch_constants)
         spread = {}
-        if statistics == "max":
+        if departures.maxima:
             spread = dict(variance=float(np.var(samples, axis=0, ddof=1).max()),
                           sample_range=float(np.ptp(samples, axis=0).max()))
-        eb: ErrorBound = error_bound(bound, samples[:, k], delta, batch_k, estimator, empirical_range,
-                                     theoretical_range, **spread)
+        eb: ErrorBound = error_bound(error.bound, samples[:, k], error.delta, batch_constants, gradient.estimator,
+                                     error.range, **spread)
         eps = float(eb.eps(n))
-        alpha = coordinate_step(g, eps, c, guarded=not step_when_unsafe)
+        alpha = coordinate_step(g, eps, c, guarded=not departures.unguarded_step)
         step = np.zeros_like(grad)
         step[k] = alpha * grad[k]
-        return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, n_min, n_max))
+        return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, batches.n_min, batches.n_max))
 
     config = dict(
-        algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
-        sigma=sigma, estimator=estimator, baseline=baseline, bound=bound, delta=delta,
-        empirical_range=empirical_range, theoretical_range=theoretical_range, n_min=n_min, n_max=n_max,
-        budget=budget, score_action=score_action, c=c_bounds,
+        algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(), sigma=sigma,
+        estimator=gradient.estimator, baseline=gradient.baseline, bound=error.bound, delta=error.delta,
+        empirical_range=error.empirical_range, theoretical_range=error.theoretical_range, n_min=batches.n_min,
+        n_max=batches.n_max, budget=budget, score_action=gradient.score_action, c=c_bounds,
     )
-    # The options only when set, so a default run's record is what it always was.
-    config.update({k: v for k, v in (("n_first", n_first), ("constants", constants), ("statistics", statistics),
-                                     ("step_when_unsafe", step_when_unsafe))
-                   if v not in (None, "bounds", "component", False)})
-    return _learn(task, policy, rule, first, budget, rng, estimator, baseline, score_action, config, progress,
-                  maxima=constants == "batch")
+    # The departures only when taken, so a default run's record is what it always was.
+    config.update(method.departure_fields())
+    return _learn(task, hooks, policy, rule, first, budget, rng, gradient, config, progress,
+                  maxima=departures.batch_constants)
 
 
 def vanilla_pg(
@@ -323,82 +305,129 @@ def vanilla_pg(
     sigma: float = 1.0,
     *,
     batch_size: int = 100,
-    alpha: float | None = 1e-3,
-    step: Literal["scalar", "coordinate"] = "scalar",
-    estimator: Estimator = "gpomdp",
-    baseline: bool = True,
-    bound: Bound = "chebyshev",
-    delta: float = 0.95,
-    empirical_range: bool = False,
+    step: FixedStep | SafeStep = FixedStep(1e-3),
+    gradient: Gradient = Gradient(),
+    target: Target | None = None,
     budget: int = 1_000_000,
-    score_action: ScoreAction = "clipped",
     rng: RNGLike = None,
     progress: Progress = False,
     stop_on_divergence: bool = False,
-    target_return: float | None = None,
-    update_at_target: bool = False,
 ) -> LearningRecord:
     r"""Policy gradient with a fixed batch size.
 
-    With a fixed ``alpha``: :math:`\theta \leftarrow \theta + \alpha\hat\nabla J` (``step="scalar"``)
-    or only the largest component moves (``step="coordinate"``). With ``alpha=None`` the
-    step is adaptive, using the bound's eps at the fixed N: the scalar step of [24]
-    (``"scalar"``) or the coordinate step Lambda* of Corollary 4.2.8 (``"coordinate"``),
-    as compared in Section 5.2.1 (Figures 5.5-5.6). A fixed step can make theta diverge
-    until the gradient overflows: with ``stop_on_divergence=True`` the run then ends and
-    the record says so (``diverged``), instead of raising.
+    With a :class:`~safepg.options.FixedStep`: :math:`\theta \leftarrow \theta +
+    \alpha\hat\nabla J` (``kind="scalar"``) or only the largest component moves
+    (``kind="coordinate"``). With a :class:`~safepg.options.SafeStep` the step is adaptive,
+    using the bound's eps at the fixed N: the scalar step of [24] (``"scalar"``) or the
+    coordinate step Lambda* of Corollary 4.2.8 (``"coordinate"``), as compared in Section
+    5.2.1 (Figures 5.5-5.6). A fixed step can make theta diverge until the gradient
+    overflows: with ``stop_on_divergence=True`` the run then ends and the record says so
+    (``diverged``), instead of raising.
 
-    ``target_return`` stops the run at the first batch whose mean measured return reaches
-    it, without updating (``reached_target``): the protocol that learns the cart-pole
-    baseline policy of Section 5.3 ("we stop once an average performance of 195 over the
-    batch is achieved"). ``budget`` then caps the search. With ``update_at_target=True``
-    the batch that reaches the target still updates theta before the run stops, as in the
-    authors' baseline script (its saved policy is one update past the batch that reached 195).
+    Parameters
+    ----------
+    task : Task
+        As in :func:`adaptive_pg`.
+    theta0 : ndarray or float
+        Initial parameters (flat vector or gain matrix).
+    sigma : float
+        Policy standard deviation.
+    batch_size : int
+        Trajectories per iteration.
+    step : FixedStep or SafeStep
+        The step (:class:`~safepg.options.FixedStep`, :class:`~safepg.options.SafeStep`).
+    gradient : Gradient
+        Estimator, baseline and score (:class:`~safepg.options.Gradient`).
+    target : Target or None
+        Stop at the first batch whose mean measured return reaches ``target.value``
+        (``reached_target``), the protocol that learns the cart-pole baseline policy of
+        Section 5.3; ``budget`` then caps the search (:class:`~safepg.options.Target`).
+    budget : int
+        Total number of trajectories.
+    rng : int, Generator or None
+        Seed or Generator.
+    progress : bool or callable
+        As in :func:`adaptive_pg`.
+    stop_on_divergence : bool
+        End the run (``diverged``) instead of raising when the gradient estimate is not finite.
 
-    ``progress`` is as in :func:`adaptive_pg`: True for a tqdm bar, or a callable
-    ``progress(used, budget)`` called after each batch, whose exceptions stop the run.
+    Returns
+    -------
+    LearningRecord
+        The per-iteration arrays and the settings in ``config``.
     """
-    if int(batch_size) != batch_size or batch_size < 2:
-        raise ValueError(f"batch_size must be an integer >= 2, got {batch_size}")
-    if alpha is not None and not (np.isfinite(alpha) and alpha >= 0):
-        raise ValueError(f"alpha must be finite and >= 0, got {alpha}")
-    if step not in ("scalar", "coordinate"):
-        raise ValueError(f"step must be 'scalar' or 'coordinate', got {step!r}")
-    if alpha is None:
-        check_delta(delta)
-    if target_return is not None and not np.isfinite(target_return):
-        raise ValueError(f"target_return must be finite or None, got {target_return}")
+    Vanilla(batch_size, step, gradient, target)  # checks batch_size and each option's type
     _check_budget(budget, batch_size)
-    policy = _initial_policy(task, theta0, sigma)
+    hooks = task_hooks(task)
+    policy = _initial_policy(hooks, theta0, sigma)
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
+    safe_step = step if isinstance(step, SafeStep) else None
 
     def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
-        eps, safe, a = 0.0, True, alpha
-        if alpha is None:
+        if safe_step is None:
+            eps, safe, a = 0.0, True, step.alpha
+        else:
+            e = safe_step.error
             # One common eps for all components: the largest per-component bound.
-            eps = max(float(error_bound(bound, samples[:, i], delta, constants, estimator,
-                                        empirical_range).eps(n)) for i in range(grad.size))
+            eps = max(float(error_bound(e.bound, samples[:, i], e.delta, constants, gradient.estimator,
+                                        e.range).eps(n)) for i in range(grad.size))
             safe = eps < abs(grad[k])
-            a = scalar_step(grad, eps, c) if step == "scalar" else coordinate_step(abs(grad[k]), eps, c)
-        assert a is not None
-        if step == "scalar":
+            a = scalar_step(grad, eps, c) if step.kind == "scalar" else coordinate_step(abs(grad[k]), eps, c)
+        if step.kind == "scalar":
             return _Update(a * grad, a, -1, eps, safe, batch_size)
         d = np.zeros_like(grad)
         d[k] = a * grad[k]
         return _Update(d, a, k, eps, safe, batch_size)
 
+    e = safe_step.error if safe_step is not None else ErrorModel()
     config = dict(
         algorithm="vanilla", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
-        sigma=sigma, batch_size=batch_size, alpha=alpha, step=step, estimator=estimator,
-        baseline=baseline, bound=bound, delta=delta, empirical_range=empirical_range,
-        budget=budget, score_action=score_action, c=c, target_return=target_return,
+        sigma=sigma, batch_size=batch_size, alpha=None if safe_step is not None else step.alpha, step=step.kind,
+        estimator=gradient.estimator, baseline=gradient.baseline, bound=e.bound, delta=e.delta,
+        empirical_range=e.empirical_range, budget=budget, score_action=gradient.score_action, c=c,
+        target_return=None if target is None else target.value,
     )
-    if update_at_target:  # only when set, so a default run's record is what it always was
+    if e.theoretical_range is not None:
+        config["theoretical_range"] = e.theoretical_range
+    if target is not None and target.update:  # only when set, so a default run's record is what it always was
         config["update_at_target"] = True
-    return _learn(task, policy, rule, batch_size, budget, rng, estimator, baseline, score_action, config, progress,
-                  stop_on_divergence, target_return, update_at_target)
+    return _learn(task, hooks, policy, rule, batch_size, budget, rng, gradient, config, progress,
+                  stop_on_divergence, target)
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "adaptive_pg", "guaranteed_improvement", "vanilla_pg"]
+def learn(task: Task, method: Method, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
+          budget: int, rng: RNGLike = None, progress: Progress = False) -> LearningRecord:
+    """Run ``method`` on ``task``: :func:`adaptive_pg` for an :class:`~safepg.options.Adaptive`,
+    :func:`vanilla_pg` for a :class:`~safepg.options.Vanilla`.
+
+    A fixed step may make theta diverge; that is a result to report, so a vanilla run then
+    ends with ``diverged`` set instead of raising (``stop_on_divergence=True``).
+
+    Parameters
+    ----------
+    task : Task
+        As in :func:`adaptive_pg`.
+    method : Adaptive or Vanilla
+        The method with all its options.
+    theta0, sigma, budget, rng, progress
+        As in :func:`adaptive_pg`.
+
+    Returns
+    -------
+    LearningRecord
+    """
+    if isinstance(method, Adaptive):
+        return adaptive_pg(task, theta0, sigma, gradient=method.gradient, error=method.error,
+                           batches=method.batches, departures=method.departures, budget=budget, rng=rng,
+                           progress=progress)
+    if isinstance(method, Vanilla):
+        return vanilla_pg(task, theta0, sigma, batch_size=method.batch_size, step=method.step,
+                          gradient=method.gradient, target=method.target, budget=budget, rng=rng, progress=progress,
+                          stop_on_divergence=True)
+    raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
+
+
+__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "adaptive_pg", "guaranteed_improvement", "learn",
+           "vanilla_pg"]

@@ -21,22 +21,22 @@ N_STAR_FACTOR = (13 + 3 * math.sqrt(17)) / 2
 ALPHA_STAR_FACTOR = (13 - 3 * math.sqrt(17)) / 4
 
 
-def penalty_constant(k: TaskConstants) -> float:
+def penalty_constant(constants: TaskConstants) -> float:
     r"""Penalty constant c of Theorem 4.2.3.
 
     .. math:: c = \frac{R M_\phi^2}{(1-\gamma)^2\sigma^2}
               \Big(\frac{|\mathcal A|}{\sqrt{2\pi}\,\sigma} + \frac{\gamma}{2(1-\gamma)}\Big)
     """
-    g, s = k.gamma, k.sigma
-    if getattr(k, "horizon_term", "effective") != "effective":
+    R, M, A, gamma, s = constants.R, constants.M_phi, constants.A_volume, constants.gamma, constants.sigma
+    if constants.horizon_term != "effective":
         # The same constant with 1 / (1 - gamma) replaced by the horizon factor h
         # (TaskConstants.horizon_term): c = R M^2 h^2 / sigma^2 (|A| / (sqrt(2 pi) sigma) + gamma h / 2).
-        h = k.horizon_factor
-        return k.R * (k.M_phi * k.M_phi) * (h * h) / (s * s) * (k.A_volume / (math.sqrt(2 * math.pi) * s) + g * h / 2)
+        h = constants.horizon_factor
+        return R * (M * M) * (h * h) / (s * s) * (A / (math.sqrt(2 * math.pi) * s) + gamma * h / 2)
     # Squares as products (bit-exact, like the correctly rounded x**2); Python's ** calls
     # libm's pow, whose last bit depends on the CPU (safepg.portable).
-    return k.R * (k.M_phi * k.M_phi) / ((1 - g) * (1 - g) * (s * s)) * (
-        k.A_volume / (math.sqrt(2 * math.pi) * s) + g / (2 * (1 - g))
+    return R * (M * M) / ((1 - gamma) * (1 - gamma) * (s * s)) * (
+        A / (math.sqrt(2 * math.pi) * s) + gamma / (2 * (1 - gamma))
     )
 
 

@@ -86,7 +86,7 @@ class LearningRecord:
         The run stopped because the gradient estimate overflowed (theta diverged under a
         fixed step); only with ``stop_on_divergence=True``.
     reached_target : bool
-        The run stopped because a batch's mean return reached ``target_return``; that
+        The run stopped because a batch's mean return reached its ``Target``; that
         last batch made no update, so ``theta_final`` is the policy that reached it.
     """
 

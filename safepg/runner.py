@@ -28,14 +28,15 @@ import math
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 from tqdm.auto import tqdm
 
-from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.learning import LearningRecord, learn
+from safepg.options import Adaptive, Batches, ErrorModel, FixedStep, Method, SafeStep, Vanilla
 from safepg.store import DamagedRunsError, OnDamaged, load_stored, remove_stale_temp_files, save_atomic
 
 #: Bump when a change to the library alters the numbers a run produces; stored runs with
@@ -69,53 +70,69 @@ def make_env(name: str) -> Any:
 
 @dataclass(frozen=True)
 class RunConfig:
-    """One learning configuration (the keyword arguments of a learning loop).
+    """One learning run's settings: a method and the task it learns, from a start.
 
-    ``env`` names the task; a task :func:`make_env` does not know is built by
-    ``env_factory`` (a picklable callable with no arguments), and ``env`` is then the name
-    that enters the key. ``warm_start`` names the run whose final parameters, seed by seed,
-    start this one, and ``warm_start_key`` is that run's :meth:`key`, so that a changed
-    starting run changes this run's key too.
-
-    The options after ``target_return`` are None unless set, and an unset option stays out
-    of the key (existing runs keep their keys); set, they pass to the learning loop:
-    ``n_first``, ``constants``, ``statistics``, ``step_when_unsafe`` to :func:`adaptive_pg`
-    and ``update_at_target`` to :func:`vanilla_pg` (the authors' ways of running, see there).
+    ``method`` is an :class:`~safepg.options.Adaptive` (Algorithm 4.1,
+    :func:`~safepg.learning.adaptive_pg`) or a :class:`~safepg.options.Vanilla` (fixed batch
+    size, :func:`~safepg.learning.vanilla_pg`) with all its options. ``env`` names the task; a
+    task :func:`make_env` does not know is built by ``env_factory`` (a picklable callable with
+    no arguments), and ``env`` is then the name that enters the key. ``warm_start`` names the
+    run whose final parameters, seed by seed, start this one, and ``warm_start_key`` is that
+    run's :meth:`key`, so that a changed starting run changes this run's key too.
     """
 
     name: str
-    algorithm: Literal["adaptive", "vanilla"] = "adaptive"
+    _: KW_ONLY
+    method: Method = field(default_factory=Adaptive)
     env: str = "lqg1d"
     theta0: tuple[float, ...] = (0.0,)
     sigma: float = 1.0
-    estimator: Literal["reinforce", "gpomdp"] = "gpomdp"
-    baseline: bool = True
-    bound: Literal["chebyshev", "hoeffding", "bernstein"] = "chebyshev"
-    delta: float = 0.95
-    empirical_range: bool = False
-    theoretical_range: float | None = None
-    n_min: int = 100
-    n_max: int = 500_000
-    batch_size: int | None = None
-    alpha: float | None = None
-    step: Literal["scalar", "coordinate"] = "scalar"
     budget: int = 30_000_000
-    score_action: Literal["clipped", "raw"] = "clipped"
-    target_return: float | None = None
-    n_first: int | None = None
-    constants: Literal["bounds", "batch"] | None = None
-    statistics: Literal["component", "max"] | None = None
-    step_when_unsafe: bool | None = None
-    update_at_target: bool | None = None
     warm_start: str | None = None
     warm_start_key: str | None = field(default=None, repr=False)
     env_factory: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.method, Adaptive | Vanilla):
+            raise TypeError(f"method must be an Adaptive or a Vanilla, got {self.method!r}")
+
+    @property
+    def algorithm(self) -> Literal["adaptive", "vanilla"]:
+        """``"adaptive"`` or ``"vanilla"``, the method's name in the records."""
+        return "adaptive" if isinstance(self.method, Adaptive) else "vanilla"
+
+    def fields(self) -> dict[str, Any]:
+        """The run's settings as flat named values: what :meth:`key` hashes.
+
+        The names are those of the records' ``config`` (``estimator``, ``bound``, ``n_min``...),
+        and the values of the options a method does not use are the defaults every key has
+        always held (a vanilla run's key holds ``n_min`` = 100), so that no stored run's key
+        changes. An option set away from the algorithm (``n_first``, ``constants``,
+        ``statistics``, ``step_when_unsafe``, ``update_at_target``) is present only when set.
+        """
+        m = self.method
+        error = m.error if isinstance(m, Adaptive) else m.step.error if isinstance(m.step, SafeStep) else ErrorModel()
+        d: dict[str, Any] = dict(
+            algorithm=self.algorithm, env=self.env, theta0=list(self.theta0), sigma=self.sigma,
+            estimator=m.gradient.estimator, baseline=m.gradient.baseline, score_action=m.gradient.score_action,
+            bound=error.bound, delta=error.delta, empirical_range=error.empirical_range,
+            theoretical_range=error.theoretical_range, budget=self.budget,
+        )
+        if isinstance(m, Adaptive):
+            d.update(n_min=m.batches.n_min, n_max=m.batches.n_max, step="scalar")
+            d.update(m.departure_fields())
+        else:
+            d.update(n_min=Batches().n_min, n_max=Batches().n_max, batch_size=m.batch_size, step=m.step.kind,
+                     alpha=m.step.alpha if isinstance(m.step, FixedStep) else None,
+                     target_return=None if m.target is None else m.target.value,
+                     update_at_target=True if m.target is not None and m.target.update else None)
+        if self.warm_start is not None:
+            d["warm_start"] = self.warm_start
+        return {k: v for k, v in d.items() if v is not None}
+
     def key(self) -> str:
         """Hash of everything that determines a run's numbers (not its name)."""
-        # Unset options are left out, so adding an option later keeps existing runs valid.
-        d = {k: v for k, v in asdict(self).items()
-             if k not in ("name", "warm_start_key", "env_factory") and v is not None}
+        d = self.fields()
         if self.warm_start is not None:  # a changed starting policy must invalidate this run too
             if self.warm_start_key is None:
                 raise ValueError(f"warm_start_key must be given with warm_start={self.warm_start!r} "
@@ -124,86 +141,68 @@ class RunConfig:
         blob = json.dumps([d, RESULTS_VERSION], sort_keys=True)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
-    def seed(self, k: int) -> np.random.SeedSequence:
-        """Independent stream for seed index k of this configuration."""
-        return np.random.SeedSequence([k, int(self.key(), 16) % 2**63])
+    def seed(self, index: int) -> np.random.SeedSequence:
+        """Independent stream for seed ``index`` of this configuration."""
+        return np.random.SeedSequence([index, int(self.key(), 16) % 2**63])
 
     def make_env(self) -> Any:
         """The task this configuration learns on."""
         return self.env_factory() if self.env_factory is not None else make_env(self.env)
 
-    def run(self, k: int, progress: bool = False, theta0: np.ndarray | None = None) -> LearningRecord:
-        """Run seed k.
+    def run(self, seed: int, progress: bool = False, theta0: np.ndarray | None = None) -> LearningRecord:
+        """Run seed ``seed``.
 
-        A warm-started configuration starts from ``theta0``, the final parameters of seed k
-        of the run it names; any other starts from its own ``theta0`` field.
+        A warm-started configuration starts from ``theta0``, the final parameters of that
+        seed of the run it names; any other starts from its own ``theta0`` field.
         """
         env = self.make_env()
         if self.warm_start is not None:
             if theta0 is None:
                 raise ValueError(f"theta0 must be given for the warm-started config {self.name!r}: "
-                                 f"the final theta of seed {k} of {self.warm_start!r}")
+                                 f"the final theta of seed {seed} of {self.warm_start!r}")
             theta0 = np.asarray(theta0, dtype=float)
         elif theta0 is not None:
             raise ValueError(f"theta0 is only for warm-started configs, {self.name!r} starts from {self.theta0}")
         else:
             theta0 = np.asarray(self.theta0, dtype=float)
-        common = dict(estimator=self.estimator, baseline=self.baseline, bound=self.bound,
-                      delta=self.delta, empirical_range=self.empirical_range, budget=self.budget,
-                      score_action=self.score_action, rng=np.random.default_rng(self.seed(k)),
-                      progress=progress)
-        options = {k: v for k, v in (("n_first", self.n_first), ("constants", self.constants),
-                                     ("statistics", self.statistics), ("step_when_unsafe", self.step_when_unsafe))
-                   if v is not None}
-        if self.algorithm == "adaptive":
-            if self.update_at_target is not None:
-                raise ValueError(f"update_at_target is an option of vanilla runs, not of {self.name!r}")
-            return adaptive_pg(env, theta0, self.sigma, n_min=self.n_min, n_max=self.n_max,
-                               theoretical_range=self.theoretical_range, **options, **common)
-        if self.batch_size is None:
-            raise ValueError(f"batch_size must be set for the vanilla config {self.name!r}")
-        if options:
-            raise ValueError(f"{sorted(options)} are options of adaptive runs, not of {self.name!r}")
-        # A fixed step may diverge; that is a result to report, not an error.
-        return vanilla_pg(env, theta0, self.sigma, batch_size=self.batch_size, alpha=self.alpha,
-                          step=self.step, stop_on_divergence=True, target_return=self.target_return,
-                          update_at_target=bool(self.update_at_target), **common)
+        return learn(env, self.method, theta0, self.sigma, budget=self.budget,
+                     rng=np.random.default_rng(self.seed(seed)), progress=progress)
 
 
-def run_path(folder: Path, cfg: RunConfig, k: int) -> Path:
-    """Where seed k of ``cfg`` is stored in a group's folder."""
-    return folder / cfg.name / f"seed-{k}.npz"
+def run_path(folder: Path, cfg: RunConfig, seed: int) -> Path:
+    """Where seed ``seed`` of ``cfg`` is stored in a group's folder."""
+    return folder / cfg.name / f"seed-{seed}.npz"
 
 
-def stored_run(folder: Path, cfg: RunConfig, k: int, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
-    """Seed k of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
+def stored_run(folder: Path, cfg: RunConfig, seed: int, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
+    """Seed ``seed`` of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
 
     A damaged file is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
     """
-    return load_stored(run_path(folder, cfg, k), cfg.key(), on_damaged)
+    return load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
 
 
-def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, k: int) -> None:
+def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, seed: int) -> None:
     """Stamp ``rec`` with the key :func:`stored_run` checks and save it (in the calling process,
     so the stamp is this process's key whatever the worker's copy of the definitions)."""
     rec.config["run_key"] = cfg.key()
     rec.config["config_name"] = cfg.name
-    save_atomic(rec, run_path(folder, cfg, k))
+    save_atomic(rec, run_path(folder, cfg, seed))
 
 
-def _compute(cfg: RunConfig, k: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
-    """Run seed k of ``cfg`` on a worker and return the record (the caller stores it)."""
+def _compute(cfg: RunConfig, seed: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
+    """Run seed ``seed`` of ``cfg`` on a worker and return the record (the caller stores it)."""
     if single_thread:  # joblib already uses every core; numba threads would oversubscribe
         import numba
 
         numba.set_num_threads(1)
-    return cfg.run(k, theta0=theta0)
+    return cfg.run(seed, theta0=theta0)
 
 
-def _compute_task(i: int, cfg: RunConfig, k: int, theta0: np.ndarray | None,
+def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
                   single_thread: bool) -> tuple[int, LearningRecord]:
     """:func:`_compute` tagged with the task's index: results arrive in any order."""
-    return i, _compute(cfg, k, theta0, single_thread)
+    return i, _compute(cfg, seed, theta0, single_thread)
 
 
 def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
@@ -217,9 +216,9 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
     damaged = []
     for c in configs:
         recs = []
-        for k in range(seeds):
+        for seed in range(seeds):
             try:
-                recs.append(stored_run(folder, c, k, on_damaged))
+                recs.append(stored_run(folder, c, seed, on_damaged))
             except DamagedRunsError as err:
                 damaged.extend(err.damaged)
         out[c.name] = [r for r in recs if r is not None]
@@ -272,23 +271,24 @@ def run_configs(
             raise ValueError(f"starts must give {seeds} starting points for the warm-started config {c.name!r}")
     # Files a killed runner was writing; a live runner's are kept.
     remove_stale_temp_files(folder)
-    todo = [(c, k) for c in configs for k in range(seeds) if stored_run(folder, c, k, "set_aside") is None]
+    todo = [(c, seed) for c in configs for seed in range(seeds) if stored_run(folder, c, seed, "set_aside") is None]
     # Longest runs first, so that no long run is dispatched last and leaves the other workers
     # idle at the end: the largest budgets, and among equal budgets the smallest fixed batch
     # sizes (more iterations, each with its per-batch overhead: Table 5.3's N = 100 runs take
     # about twice as long as its adaptive ones). Stable: ties keep the given order.
-    todo.sort(key=lambda ck: (-ck[0].budget, ck[0].batch_size if ck[0].batch_size is not None else math.inf))
+    todo.sort(key=lambda cs: (-cs[0].budget,
+                              cs[0].method.batch_size if isinstance(cs[0].method, Vanilla) else math.inf))
     if todo:
         started = time.perf_counter()
         n_jobs = effective_n_jobs(jobs)
-        tasks = (delayed(_compute_task)(i, c, k, None if c.warm_start is None else starts[c.name][k], n_jobs > 1)
-                 for i, (c, k) in enumerate(todo))
+        tasks = (delayed(_compute_task)(i, c, seed, None if c.warm_start is None else starts[c.name][seed], n_jobs > 1)
+                 for i, (c, seed) in enumerate(todo))
         with tqdm(total=len(todo), desc=desc or folder.name, unit="run", disable=not progress) as bar:
             for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
                 if rec.interrupted:  # Ctrl-C caught by a run in this process: stop the campaign
                     raise KeyboardInterrupt
-                c, k = todo[i]
-                store_run(rec, folder, c, k)
+                c, seed = todo[i]
+                store_run(rec, folder, c, seed)
                 bar.update()
         record_timing(folder, time.perf_counter() - started, len(todo), n_jobs)
     return load_configs(configs, seeds, folder)

@@ -16,7 +16,7 @@ from scipy import stats as scipy_stats
 
 from safepg.stats import mean_ci95, prediction_interval95, seed_summary95
 from safepg.thesis import scorecard as sc
-from safepg.thesis.scorecard.builder import Builder
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 
 
 # ------------------------------------------------------------------ the prediction interval
@@ -68,24 +68,24 @@ FROZEN = "θ moved by at most 3.0e-07 over the run: the ratio carries no informa
 def test_single_run_inside_and_outside_the_prediction_interval():
     b = Builder()
     inside, outside = [41.8, 55.4], [41.8, 52.9]
-    b.add(id="r/inside", ok=sc.in_prediction("53.01", inside), interval=inside, interval_text="[41.8%; 55.4%]",
-          seeds=5, **COMMON)
-    b.add(id="r/outside", ok=sc.in_prediction("53.01", outside), interval=outside, interval_text="[41.8%; 52.9%]",
-          seeds=5, **COMMON)
+    b.add(RowSpec(id="r/inside", ok=sc.in_prediction("53.01", inside), interval=inside,
+                  interval_text="[41.8%; 55.4%]", seeds=5, **COMMON))
+    b.add(RowSpec(id="r/outside", ok=sc.in_prediction("53.01", outside), interval=outside,
+                  interval_text="[41.8%; 52.9%]", seeds=5, **COMMON))
     assert [r.status for r in b.rows] == ["reproduced", "open"]
     assert b.rows[0].judged_interval == inside and b.rows[0].judged_seeds == 5 and b.rows[0].kind == "one run"
 
 
 def test_a_vacuous_ratio_is_not_reproduced():
     b = Builder()
-    b.add(id="v/ours", ok=True, vacuous=FROZEN, **COMMON)
+    b.add(RowSpec(id="v/ours", ok=True, vacuous=FROZEN, **COMMON))
     # The authors' column moved and holds: the row is judged there, not on the frozen run.
-    b.add(id="v/authors", ok=True, vacuous=FROZEN, authors_ok=True, authors="52.6%", authors_seeds=5,
-          authors_note="Their settings move θ.", authors_interval=[40.0, 60.0], authors_interval_text="[40%; 60%]",
-          **COMMON)
+    b.add(RowSpec(id="v/authors", ok=True, vacuous=FROZEN, **COMMON,
+                  authors=AuthorsColumn(ok=True, text="52.6%", seeds=5, note="Their settings move θ.",
+                                        interval=[40.0, 60.0], interval_text="[40%; 60%]")))
     # Both columns frozen: vacuous, judged on the authors' column where only it holds.
-    b.add(id="v/both", ok=False, authors_ok=True, authors_vacuous=FROZEN, authors="50%", **COMMON)
-    b.add(id="v/moved", ok=True, vacuous="", **COMMON)
+    b.add(RowSpec(id="v/both", ok=False, authors=AuthorsColumn(ok=True, vacuous=FROZEN, text="50%"), **COMMON))
+    b.add(RowSpec(id="v/moved", ok=True, vacuous="", **COMMON))
     got = {r.id: r for r in b.rows}
     assert got["v/ours"].status == sc.VACUOUS_STATUS and got["v/ours"].explanation.startswith("θ moved by")
     assert got["v/authors"].status == sc.AUTHORS_STATUS and got["v/authors"].judged_on == "authors' settings"
@@ -98,9 +98,11 @@ def test_a_vacuous_ratio_is_not_reproduced():
 def test_agreement_through_an_error_of_the_authors_code_is_counted_apart():
     b = Builder()
     common = {**COMMON, "rule": "rounded", "kind": "closed form", "thesis": "≈ -422.616"}
-    b.add(id="e/error", ok=False, authors_ok=True, authors_error=True, authors="-422.61600",
-          authors_note="Their J is 16 times the expectation.", **common)
-    b.add(id="e/setting", ok=False, authors_ok=True, authors="-422.61600", authors_note="A setting.", **common)
+    b.add(RowSpec(id="e/error", ok=False, authors=AuthorsColumn(ok=True, error=True, text="-422.61600",
+                                                                note="Their J is 16 times the expectation."),
+                  **common))
+    b.add(RowSpec(id="e/setting", ok=False, authors=AuthorsColumn(ok=True, text="-422.61600", note="A setting."),
+                  **common))
     assert [r.status for r in b.rows] == [sc.AUTHORS_ERROR_STATUS, sc.AUTHORS_STATUS]
     assert "16 times" in b.rows[0].explanation
     c = sc.counts(b.rows)["all"]
@@ -114,8 +116,8 @@ def test_the_status_rule_names_the_new_statuses():
 
 def test_kind_and_judged_interval_reach_the_files_and_the_page(tmp_path):
     b = Builder()
-    b.add(id="table-5.4/adaptive/improvement-ratio", ok=True, vacuous=FROZEN, interval=[41.8, 55.4],
-          interval_text="[41.8%; 55.4%]: 95% prediction interval for one run, 5 seeds", seeds=5, **COMMON)
+    b.add(RowSpec(id="table-5.4/adaptive/improvement-ratio", ok=True, vacuous=FROZEN, interval=[41.8, 55.4],
+                  interval_text="[41.8%; 55.4%]: 95% prediction interval for one run, 5 seeds", seeds=5, **COMMON))
     files = sc.write_scorecard(tmp_path, b.rows)
     row = json.loads(files["scorecard.json"].read_text())["rows"][0]
     assert row["kind"] == "one run" and row["judged_interval"] == [41.8, 55.4] and row["judged_seeds"] == 5
@@ -142,9 +144,9 @@ def test_a_ratio_is_judged_within_one_update_of_our_seeds():
 
 def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status(tmp_path):
     b = Builder()
-    b.add(id="f/authors", ok=True, vacuous=FROZEN, authors_ok=True, authors="53.06%", authors_note="Their run.",
-          **COMMON)
-    b.add(id="f/clean", ok=True, **COMMON)
+    b.add(RowSpec(id="f/authors", ok=True, vacuous=FROZEN, **COMMON,
+                  authors=AuthorsColumn(ok=True, text="53.06%", note="Their run.")))
+    b.add(RowSpec(id="f/clean", ok=True, **COMMON))
     flagged, clean = b.rows
     assert flagged.status == sc.AUTHORS_STATUS and flagged.no_information == FROZEN
     assert "agrees too, without information" in flagged.explanation and not clean.no_information
@@ -156,9 +158,9 @@ def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status
 
 def test_the_chapters_count_sentence_names_every_status_with_rows():
     b = Builder()
-    b.add(id="c/ok", ok=True, **COMMON)
-    b.add(id="c/vacuous", ok=True, vacuous=FROZEN, **COMMON)
-    b.add(id="c/open", ok=False, **COMMON)
+    b.add(RowSpec(id="c/ok", ok=True, **COMMON))
+    b.add(RowSpec(id="c/vacuous", ok=True, vacuous=FROZEN, **COMMON))
+    b.add(RowSpec(id="c/open", ok=False, **COMMON))
     assert sc.counts_text(b.rows) == ("3 printed results: 1 reproduced, 1 that agree without carrying information, "
                                       "1 open; in 1 of them one of our columns agrees with the print without "
                                       "information")

@@ -69,6 +69,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
+from safepg.tasks import ActionDimension, GradientBatch, GradientBatchMaxima, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -188,7 +189,7 @@ def _check_integrator(integrator: str) -> None:
 
 
 @dataclass(frozen=True)
-class CartPole:
+class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimension):
     r"""The continuous cart-pole task of Section 5.3, simulated N carts at a time.
 
     Parameters
@@ -535,7 +536,7 @@ class CartPole:
         authors' cart-pole script put into the penalty constant in place of R and M_phi: the
         largest |reward| and the largest |phi_i(s)| over every state the batch visited, the
         initial states and the states the episodes ended in (the failing state, or s_H)
-        included. The learning loop's ``constants="batch"`` calls it.
+        included. The learning loop calls it with ``Departures(batch_constants=True)``.
 
         Returns
         -------

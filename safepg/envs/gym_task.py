@@ -34,6 +34,7 @@ from safepg import portable
 from safepg.constants import HORIZON_TERMS
 from safepg.policies import LinearGaussianPolicy
 from safepg.rng import RNGLike, as_generator
+from safepg.tasks import ActionDimension, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -70,7 +71,7 @@ def _constant_missing(name: str, what: str) -> ValueError:
     )
 
 
-class GymTask:
+class GymTask(MeasuredReturns, ActionDimension):
     r"""A gymnasium environment (``Box`` observations and actions) as a safe-PG task.
 
     ``simulate(policy, n, rng)`` runs n episodes of horizon H at once in a
@@ -146,7 +147,7 @@ class GymTask:
     Missing R and M_phi are reported where they are needed, not at construction, so a
     task without them can still simulate and estimate J by Monte Carlo. Both learning
     loops need them: they compute the penalty constant when they start, even
-    ``vanilla_pg`` with a fixed ``alpha`` (where it is only recorded in the config).
+    ``vanilla_pg`` with a ``FixedStep`` (where it is only recorded in the config).
 
     Seeding: ``simulate`` draws, from ``rng`` and in this order, one 63-bit seed per
     episode (passed to the vector env's ``reset``) and then an (n, H, d_a) array of

@@ -27,6 +27,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
+from safepg.tasks import ActionDimension, GradientBatch, Performance, PerformanceBatch
 from safepg.trajectories import Trajectories
 
 
@@ -48,7 +49,7 @@ def _largest_eigenvalue(M: np.ndarray) -> float:
 
 
 @dataclass(frozen=True)
-class LQG:
+class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
     """LQG regulation task with box-bounded states and actions.
 
     Parameters
@@ -125,6 +126,11 @@ class LQG:
         return float((2 * self.action_bound) ** self.dim)
 
     # ----------------------------------------------------------------- simulator
+    @property
+    def action_dim(self) -> int:  # type: ignore[override]
+        """Actions have as many components as states (``dim``)."""
+        return self.dim
+
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
         """Simulate ``n`` trajectories of length H at once.
 

@@ -22,7 +22,8 @@ from safepg import portable
 from safepg.envs.cartpole import CartPole
 from safepg.runner import RESULTS_VERSION, TIMING_FILE
 from safepg.thesis.cartpole_sweep import baseline_experiments
-from safepg.thesis.experiments import experiment_folder, get_experiment, load_experiment, make_env
+from safepg.thesis.experiment_store import experiment_folder, load_experiment
+from safepg.thesis.experiments import get_experiment, make_env
 
 #: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
 CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {

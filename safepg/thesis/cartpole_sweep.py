@@ -35,15 +35,9 @@ from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
 from safepg.learning import LearningRecord
 from safepg.meta import ALPHA_STAR_FACTOR, penalty_constant
-from safepg.thesis.experiments import (
-    CARTPOLE_SWEEP,
-    SWEEP_BUDGET,
-    SWEEP_SEEDS,
-    get_experiment,
-    load_experiment,
-    make_env,
-    run_experiment,
-)
+from safepg.thesis.experiment_store import load_experiment, run_experiment
+from safepg.thesis.experiments import get_experiment, make_env
+from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BUDGET, SWEEP_SEEDS
 
 #: The thesis's printed numbers the sweep is held against (Section 5.3, Table 5.4).
 THESIS = {"baseline_iterations": 72, "adaptive_upsilon_bar": 193.12, "adaptive_improvement_ratio": 0.5301,
@@ -91,10 +85,10 @@ def penalty_grid(gammas: tuple[float, ...] = GRID_GAMMAS, horizon_terms: tuple[s
     for gamma, term, m_phi, vol, r in itertools.product(gammas, horizon_terms, m_phis, volumes, rewards):
         if gamma == 1 and term == "effective":
             continue
-        k = TaskConstants(R=r, M_phi=m_phi, A_volume=vol, A_bar=10.0, gamma=gamma, H=horizon, sigma=sigma,
-                          horizon_term=term)
-        c = penalty_constant(k)
-        rows.append({"gamma": gamma, "horizon_term": term, "h": k.horizon_factor, "M_phi": m_phi,
+        constants = TaskConstants(R=r, M_phi=m_phi, A_volume=vol, A_bar=10.0, gamma=gamma, H=horizon, sigma=sigma,
+                                  horizon_term=term)
+        c = penalty_constant(constants)
+        rows.append({"gamma": gamma, "horizon_term": term, "h": constants.horizon_factor, "M_phi": m_phi,
                      "A_volume": vol, "R": r, "c": c, "max_step": max_safe_step(c),
                      "step_at_n_star": ALPHA_STAR_FACTOR / c,
                      "can_move": max_safe_step(c) >= CAN_MOVE_SHARE * VANILLA_ALPHA})

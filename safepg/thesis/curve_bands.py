@@ -220,18 +220,19 @@ def _lqg1d_scores(recs: Mapping[str, Sequence[LearningRecord]]) -> list[CurveSco
     for cfg in exp.configs:
         if cfg.name not in recs or not recs[cfg.name]:
             continue
-        key = (cfg.estimator, cfg.bound, cfg.empirical_range, cfg.delta)
-        both = cfg.bound == "chebyshev" and cfg.estimator == "gpomdp" and cfg.delta == 0.95
-        figure = "5.1" if cfg.bound == "chebyshev" else "5.2"
+        estimator, error = cfg.method.gradient.estimator, cfg.method.error
+        key = (estimator, error.bound, error.empirical_range, error.delta)
+        both = error.bound == "chebyshev" and estimator == "gpomdp" and error.delta == 0.95
+        figure = "5.1" if error.bound == "chebyshev" else "5.2"
         where = "Figures 5.1 and 5.2" if both else f"Figure {figure}"
         s = overlays.figure51_52_overlay_series(recs, cfg)
         scores.append(_score(figure, cfg.name, "J(θ) of the policy in use (closed form), every 1000 trajectories",
                              where, _source(curves[key]), exp.name, overlays.FIGURES_51_52_RUNS, "trajectories",
                              s["x"], s["authors"],
                              s["values"], rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS)))
-        if not (cfg.estimator == "gpomdp" and cfg.delta == 0.95):
+        if not (estimator == "gpomdp" and error.delta == 0.95):
             continue
-        figure, where = ("5.3", "Figures 5.3 and 5.4") if cfg.bound == "chebyshev" else ("5.4", "Figure 5.4")
+        figure, where = ("5.3", "Figures 5.3 and 5.4") if error.bound == "chebyshev" else ("5.4", "Figure 5.4")
         ours = by_iteration(recs[cfg.name], "batch_size")
         for run in runs52.get(key, []):
             theirs, mine = _pad(np.asarray(run["N"], dtype=float), ours)

@@ -2,32 +2,40 @@ r"""The experiments of Chapter 5, defined once as data, with the values the thes
 
 An :class:`Experiment` is a named group of :class:`~safepg.runner.RunConfig` (one row of
 a table or one curve of a figure) run for several seeds, with the thesis's printed values
-beside them. :func:`run_experiment` runs what is missing through :func:`safepg.runner.run_configs`
-into ``<results>/<experiment>/<config>/seed-<k>.npz`` and :func:`report` puts ours beside
-the printed values. Which run starts where another ended (the cart-pole adaptation of
-Section 5.3 starts from each seed's baseline policy) is known here: the runner only
-receives the starting points.
+beside them; :data:`EXPERIMENTS` holds them all by name. Which run starts where another ended
+(the cart-pole adaptation of Section 5.3 starts from each seed's baseline policy) is known
+here: the runner only receives the starting points.
 
-The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
+:func:`safepg.thesis.experiment_store.run_experiment` runs what is missing into the results
+folder and :func:`safepg.thesis.report.report` puts ours beside the printed values.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import KW_ONLY, dataclass, field, replace
 from functools import partial
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
+from safepg.bounds import Range
 from safepg.envs.lqg import LQG
-from safepg.learning import CHECKPOINTS, LearningRecord
-from safepg.runner import RunConfig, load_configs, run_configs, stored_run
+from safepg.options import (
+    Adaptive,
+    Batches,
+    Departures,
+    ErrorModel,
+    FixedStep,
+    Gradient,
+    Method,
+    SafeStep,
+    Target,
+    Vanilla,
+)
+from safepg.runner import RunConfig
 from safepg.runner import make_env as make_core_env
-from safepg.stats import seed_summary95
-from safepg.store import OnDamaged, results_dir
-from safepg.thesis import authors
-from safepg.thesis.authors import TABLE_5_4_BUDGET, budget_average, cartpole_theta_star, strict_improvement_ratio
+from safepg.thesis.authors import TABLE_5_4_BUDGET, cartpole_theta_star
+from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BASELINE_CAP, SWEEP_BUDGET, SWEEP_SEEDS
 
 #: The 2-D LQG the Section 5.2 experiments run on: the printed task with gamma = 0.9 instead
 #: of the printed 0.95, the discount that reproduces the printed theta*, final parameters and
@@ -64,16 +72,39 @@ class Experiment:
     name: str
     description: str
     configs: tuple[RunConfig, ...]
+    _: KW_ONLY
     seeds: int = 5
     thesis: dict[str, dict[str, Any]] = field(default_factory=dict)
     performance: Literal["J", "J_hat"] = "J"
     rules: Literal["ours", "authors"] = "ours"
 
     def config(self, name: str) -> RunConfig:
+        """The configuration named ``name``."""
         for c in self.configs:
             if c.name == name:
                 return c
         raise KeyError(f"{self.name} has no config {name!r}")
+
+    def single_config(self) -> RunConfig:
+        """The one configuration of an experiment another warm-starts from."""
+        if len(self.configs) != 1:
+            raise ValueError(f"warm_start must name an experiment with one config, {self.name!r} has "
+                             f"{len(self.configs)}")
+        return self.configs[0]
+
+
+def _with_gradient(method: Method, **changes: Any) -> Method:
+    """``method`` with fields of its :class:`~safepg.options.Gradient` changed."""
+    return replace(method, gradient=replace(method.gradient, **changes))
+
+
+def _with_error(method: Adaptive, **changes: Any) -> Adaptive:
+    """``method`` with fields of its :class:`~safepg.options.ErrorModel` changed."""
+    return replace(method, error=replace(method.error, **changes))
+
+
+#: The bound of Table 5.3 and Table 5.4's adaptive runs: empirical Bernstein with the batch's range.
+BERNSTEIN_ER = ErrorModel("bernstein", 0.95, "empirical")
 
 
 # ------------------------------------------------------------------ Section 5.1
@@ -102,12 +133,12 @@ def _table_5_1(theta0: float = T51_THETA0) -> Experiment:
         for n in T51_NS:
             for alpha, printed in zip(T51_ALPHAS, T51_PRINTED[sigma][n]):
                 name = f"sigma={sigma}-N={n}-alpha={alpha:.0e}"
-                configs.append(RunConfig(name, "vanilla", theta0=(theta0,), sigma=sigma, batch_size=n,
-                                         alpha=alpha, budget=1_000_000))
+                configs.append(RunConfig(name, method=Vanilla(n, FixedStep(alpha)), theta0=(theta0,), sigma=sigma,
+                                         budget=1_000_000))
                 thesis[name] = {"improvement_ratio": round(printed / 100, 6)}
     return Experiment("table-5.1", "Improvement ratio of vanilla G(PO)MDP with fixed step and batch "
                       f"size, 10^6 trajectories (Table 5.1), from theta_0 = {theta0} (the thesis prints "
-                      f"{T51_PRINTED_THETA0}; {T51_THETA0} is our reconstruction).", tuple(configs), 5, thesis)
+                      f"{T51_PRINTED_THETA0}; {T51_THETA0} is our reconstruction).", tuple(configs), thesis=thesis)
 
 
 def _table_5_1_printed_theta0() -> Experiment:
@@ -150,28 +181,31 @@ def _table_5_2() -> Experiment:
     configs, thesis = [], {}
     for est, bound, er, delta, ups, ci in _T52_PRINTED:
         name = t52_name(est, bound, er, delta)
-        # Only Hoeffding/Bernstein without the empirical range use a theoretical range.
-        theory_range = RECONSTRUCTED_RANGE if bound != "chebyshev" and not er else None
-        configs.append(RunConfig(name, estimator=est, bound=bound, empirical_range=er, delta=delta,  # type: ignore[arg-type]
-                                 theoretical_range=theory_range))
+        # Only Hoeffding/Bernstein without the empirical range use a range other than the batch's.
+        grad_range: Range = "empirical" if er else RECONSTRUCTED_RANGE if bound != "chebyshev" else "lemma"
+        configs.append(RunConfig(name, method=Adaptive(Gradient(est), ErrorModel(bound, delta, grad_range))))
         thesis[name] = {"upsilon_bar": ups, "ci95": list(ci)}
     return Experiment("table-5.2", "Adaptive batch size on the 1-D LQG: the twelve estimator x bound x "
                       "delta rows of Table 5.2 (theta_0 = 0, sigma = 1, 3*10^7 trajectories), "
                       "also Figures 5.1-5.4; the theoretical range is our reconstruction 1280.",
-                      tuple(configs), 5, thesis)
+                      tuple(configs), thesis=thesis)
+
+
+def _theoretical_range_rows(t52: Experiment) -> list[RunConfig]:
+    """The rows of Table 5.2 run with a given range (Hoeffding and Bernstein without the empirical range)."""
+    return [c for c in t52.configs if isinstance(c.method, Adaptive) and c.method.error.theoretical_range is not None]
 
 
 def _table_5_2_lemma_range() -> Experiment:
     t52 = _table_5_2()
     configs, thesis = [], {}
-    for c in t52.configs:
-        if c.theoretical_range is not None:
-            name = f"{c.name}-lemma-range"
-            configs.append(replace(c, name=name, theoretical_range=None))  # None: Lemma 4.3.3's range
-            thesis[name] = t52.thesis[c.name]
+    for c in _theoretical_range_rows(t52):
+        name = f"{c.name}-lemma-range"
+        configs.append(replace(c, name=name, method=_with_error(c.method, range="lemma")))
+        thesis[name] = t52.thesis[c.name]
     return Experiment("table-5.2-lemma-range", "The two theoretical-range rows of Table 5.2 with Lemma "
                       "4.3.3's range 6400 instead of the reconstructed 1280 (the printed lemma, which "
-                      "reproduces neither row).", tuple(configs), 5, thesis)
+                      "reproduces neither row).", tuple(configs), thesis=thesis)
 
 
 def _table_5_1_no_baseline() -> Experiment:
@@ -179,16 +213,17 @@ def _table_5_1_no_baseline() -> Experiment:
     return replace(t51, name="table-5.1-no-baseline",
                    description="Table 5.1 from the printed theta_0 = -0.55 with G(PO)MDP without baseline "
                                "(b = 0): the thesis does not say which baseline it used.",
-                   configs=tuple(replace(c, baseline=False) for c in t51.configs))
+                   configs=tuple(replace(c, method=_with_gradient(c.method, baseline=False)) for c in t51.configs))
 
 
 def _table_5_2_raw_score() -> Experiment:
     t52 = _table_5_2()
     keep = [t52_name("gpomdp", "chebyshev", False, 0.95), t52_name("gpomdp", "bernstein", True, 0.95)]
-    configs = tuple(replace(t52.config(n), name=f"{n}-raw-score", score_action="raw") for n in keep)
+    configs = tuple(replace(t52.config(n), name=f"{n}-raw-score",
+                            method=_with_gradient(t52.config(n).method, score_action="raw")) for n in keep)
     return Experiment("table-5.2-raw-score", "Two rows of Table 5.2 with the unbiased score of the sampled "
-                      "(unclipped) action instead of the authors' clipped-action score.", configs, 5,
-                      {f"{n}-raw-score": t52.thesis[n] for n in keep})
+                      "(unclipped) action instead of the authors' clipped-action score.", configs,
+                      thesis={f"{n}-raw-score": t52.thesis[n] for n in keep})
 
 
 # ------------------------------------------------------------------ Section 5.2
@@ -198,28 +233,27 @@ _PRINTED_THETA_COORDINATE = [[-0.0275, 0.0], [0.0, -0.0274]]
 
 
 def _figures_5_5_5_6() -> Experiment:
-    common = dict(algorithm="vanilla", env="lqg2d-gamma0.9", theta0=(0.0,) * 4, batch_size=2000,
-                  alpha=None, bound="chebyshev", delta=0.95)
-    configs = (RunConfig("scalar", step="scalar", **common),  # type: ignore[arg-type]
-               RunConfig("coordinate", step="coordinate", **common))  # type: ignore[arg-type]
+    error = ErrorModel("chebyshev", 0.95)
+    configs = tuple(RunConfig(kind, method=Vanilla(2000, SafeStep(kind, error)), env="lqg2d-gamma0.9",
+                              theta0=(0.0,) * 4) for kind in ("scalar", "coordinate"))
     thesis = {"scalar": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_SCALAR},
               "coordinate": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_COORDINATE}}
     return Experiment("figures-5.5-5.6", "2-D LQG: the scalar adaptive step of [24] against the coordinate "
                       "step Lambda* (G(PO)MDP, Chebyshev, delta = 0.95, N = 2000, 3*10^7 trajectories), "
-                      "Figures 5.5-5.6.", configs, 5, thesis)
+                      "Figures 5.5-5.6.", configs, thesis=thesis)
 
 
 def _table_5_3() -> Experiment:
-    common = dict(env="lqg2d-gamma0.9", theta0=(0.0,) * 4)
-    configs = (RunConfig("adaptive", bound="bernstein", empirical_range=True, **common),  # type: ignore[arg-type]
-               RunConfig("N=1000", "vanilla", batch_size=1000, alpha=1e-6, **common),  # type: ignore[arg-type]
-               RunConfig("N=100", "vanilla", batch_size=100, alpha=1e-6, **common))  # type: ignore[arg-type]
+    task = partial(RunConfig, env="lqg2d-gamma0.9", theta0=(0.0,) * 4)
+    configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
+               task("N=1000", method=Vanilla(1000, FixedStep(1e-6))),
+               task("N=100", method=Vanilla(100, FixedStep(1e-6))))
     thesis = {"adaptive": {"upsilon_bar": -20.50, "improvement_ratio": 1.0},
               "N=1000": {"upsilon_bar": -22.39, "improvement_ratio": 1.0},
               "N=100": {"upsilon_bar": -19.77, "improvement_ratio": 0.89}}
     return Experiment("table-5.3", "2-D LQG: adaptive batch size (G(PO)MDP, Bernstein with empirical range, "
                       "delta = 0.95) against fixed N = 1000 and N = 100 with alpha = 1e-6, 3*10^7 "
-                      "trajectories (Table 5.3, Figures 5.7-5.8).", configs, 5, thesis)
+                      "trajectories (Table 5.3, Figures 5.7-5.8).", configs, thesis=thesis)
 
 
 # ------------------------------------------------------------------ Section 5.3
@@ -231,105 +265,25 @@ _BASELINE_CAP = 4000 * 400
 
 
 def _cartpole_baseline() -> Experiment:
-    cfg = RunConfig("baseline", "vanilla", env="cartpole", theta0=(0.0,) * 4, batch_size=4000, alpha=0.01,
-                    budget=_BASELINE_CAP, target_return=195.0)
+    cfg = RunConfig("baseline", method=Vanilla(4000, FixedStep(0.01), target=Target(195.0)), env="cartpole",
+                    theta0=(0.0,) * 4, budget=_BASELINE_CAP)
     return Experiment("cartpole-baseline", "Cart-pole, 1 m pole: vanilla G(PO)MDP with alpha = 0.01 and "
                       "N = 4000 from theta = 0 until a batch's average return reaches 195 (Section 5.3).",
-                      (cfg,), 5, {"baseline": {"iterations": 72, "J_hat_final": 195.0}}, "J_hat")
+                      (cfg,), thesis={"baseline": {"iterations": 72, "J_hat_final": 195.0}}, performance="J_hat")
 
 
 def _table_5_4() -> Experiment:
-    common = dict(env="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
-    configs = (RunConfig("adaptive", bound="bernstein", empirical_range=True, **common),  # type: ignore[arg-type]
-               RunConfig("N=4000", "vanilla", batch_size=4000, alpha=0.01, **common))  # type: ignore[arg-type]
+    task = partial(RunConfig, env="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
+    configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
+               task("N=4000", method=Vanilla(4000, FixedStep(0.01))))
     thesis = {"adaptive": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301},
               "N=4000": {"upsilon_bar": 192.86, "improvement_ratio": 0.4476}}
     return Experiment("table-5.4", "Cart-pole with the pole doubled (2 m), from each seed's baseline policy: "
                       "adaptive (G(PO)MDP, Bernstein with empirical range, delta = 0.95) against vanilla "
                       f"alpha = 0.01, N = 4000, {CARTPOLE_BUDGET:.0e} trajectories each (Table 5.4, "
-                      "Figure 5.9).", configs, 5, thesis, "J_hat")
+                      "Figure 5.9).", configs, thesis=thesis, performance="J_hat")
 
 
-# The cart-pole sweep: which unstated settings let the adaptive step move on the
-# doubled pole? :mod:`safepg.thesis.cartpole_sweep` computes the penalty constant over the whole grid
-# of settings analytically and reads these runs back for the chapter.
-
-#: Trajectories per doubled-pole run of the sweep (both methods: 50 iterations of the
-#: vanilla N = 4000) and seeds per setting. Small on purpose, so that the chapter's sweep costs
-#: under 4 minutes on 2 cores; ``table-5.4`` is the full-budget protocol at the default setting.
-SWEEP_BUDGET = 200_000
-SWEEP_SEEDS = 2
-#: Cap on a sweep baseline search: 250 iterations of N = 4000 (the thesis needed 72).
-SWEEP_BASELINE_CAP = 4000 * 250
-
-
-@dataclass(frozen=True)
-class SweepSetting:
-    """One setting of the cart-pole sweep.
-
-    ``task`` overrides the :class:`~safepg.envs.cartpole.CartPole` fields that change what
-    is simulated or how vanilla PG learns (so the setting has its own baseline policy);
-    ``constants`` overrides only the bound constants (R, M_phi, |A|, horizon term), which
-    change nothing but the adaptive method's penalty constant c. ``doubled``: run the
-    doubled-pole comparison (False: the baseline search only). ``plausible``: False for
-    the counterfactual settings that only locate how small c must be. ``warm_start``: the
-    baseline experiment to start from instead of the setting's own (for a discount whose
-    own baseline search never reaches 195).
-    """
-
-    key: str
-    label: str
-    task: dict[str, Any] = field(default_factory=dict)
-    constants: dict[str, Any] = field(default_factory=dict)
-    doubled: bool = True
-    plausible: bool = True
-    warm_start: str | None = None
-
-    def env(self, doubled: bool, constants: bool = True) -> str:
-        """The :func:`make_env` name of this setting's task (with or without the constants)."""
-        from safepg.envs.cartpole import CartPole
-
-        base = CartPole.thesis_doubled if doubled else CartPole.thesis
-        return base(**self.task, **(self.constants if constants else {})).setting_name()
-
-    @property
-    def baseline_experiment(self) -> str:
-        """The experiment whose runs are this setting's baseline policies."""
-        if self.warm_start is not None:
-            return self.warm_start
-        return "cartpole-baseline" if not self.task else f"cartpole-baseline-{self.key}"
-
-
-def _sweep_settings() -> tuple[SweepSetting, ...]:
-    from safepg.envs.cartpole import NORMALISED_SCALE
-
-    return (
-        SweepSetting("thesis", "ours (default)"),
-        SweepSetting("gamma=0.95", "gamma 0.95", {"gamma": 0.95}, doubled=False),
-        SweepSetting("gamma=0.995", "gamma 0.995", {"gamma": 0.995}),
-        SweepSetting("gamma=0.999", "gamma 0.999", {"gamma": 0.999}),
-        SweepSetting("semi-implicit", "semi-implicit Euler", {"integrator": "semi-implicit"}),
-        SweepSetting("angle=12", "12 deg termination", {"angle_threshold_deg": 12.0}),
-        SweepSetting("tau=0.01", "time step 0.01 s", {"tau": 0.01}),
-        SweepSetting("init=0.1", "initial state in [-0.1, 0.1]^4", {"init_bound": 0.1}, doubled=False),
-        SweepSetting("normalised", "normalised features",
-                     {"feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0}),
-        # The discounts where the safe step can move (c ~ 10^3 - 10^4), adapting the normalised
-        # baseline (their own baseline searches stall far below 195).
-        SweepSetting("gamma=0.95+normalised", "gamma 0.95, normalised",
-                     {"gamma": 0.95, "feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0},
-                     warm_start="cartpole-baseline-normalised"),
-        SweepSetting("gamma=0.9+normalised", "gamma 0.9, normalised",
-                     {"gamma": 0.9, "feature_scale": NORMALISED_SCALE}, {"feature_bound": 1.0},
-                     warm_start="cartpole-baseline-normalised"),
-        SweepSetting("M_phi=0.1", "M_phi 0.1", constants={"feature_bound": 0.1}, plausible=False),
-        SweepSetting("M_phi=0.03", "M_phi 0.03", constants={"feature_bound": 0.03}, plausible=False),
-        SweepSetting("M_phi=0.01", "M_phi 0.01", constants={"feature_bound": 0.01}, plausible=False),
-    )
-
-
-#: The settings of the cart-pole sweep, by key.
-CARTPOLE_SWEEP: dict[str, SweepSetting] = {st.key: st for st in _sweep_settings()}
 
 
 def _sweep_baselines() -> list[Experiment]:
@@ -361,7 +315,8 @@ def _cartpole_sweep() -> Experiment:
     return Experiment("cartpole-sweep", "Cart-pole sweep over the settings the thesis leaves unstated: adaptive "
                       "(Bernstein with empirical range, delta = 0.95) and vanilla (alpha = 0.01, N = 4000) on "
                       f"the doubled pole from each setting's baseline, {SWEEP_BUDGET:.0e} trajectories, "
-                      f"{SWEEP_SEEDS} seeds.", tuple(configs), SWEEP_SEEDS, thesis, "J_hat")
+                      f"{SWEEP_SEEDS} seeds.", tuple(configs), seeds=SWEEP_SEEDS, thesis=thesis,
+                      performance="J_hat")
 
 
 # ------------------------------------------------------------------ the authors' settings
@@ -378,7 +333,7 @@ AUTHORS_CARTPOLE = {"angle_threshold_deg": 12.0, "gamma": 1.0, "constants_gamma"
 AUTHORS_DOUBLED = {**AUTHORS_CARTPOLE, "polemass_length": 0.05}
 #: Their adaptive runs (2-D and cart-pole): the largest sample variance and range over the
 #: components, and the step taken even when eps >= |g_k|.
-_AUTHORS_ADAPTIVE = dict(statistics="max", step_when_unsafe=True)
+AUTHORS_DEPARTURES = Departures(maxima=True, unguarded_step=True)
 
 
 def _authors_cartpole(doubled: bool) -> str:
@@ -395,24 +350,29 @@ def _table_5_1_authors() -> Experiment:
 
 
 def _table_5_3_authors() -> Experiment:
-    cfg = replace(_table_5_3().config("adaptive"), n_max=100_000, **_AUTHORS_ADAPTIVE)
+    adaptive = _table_5_3().config("adaptive")
+    cfg = replace(adaptive, method=replace(adaptive.method, batches=Batches(n_max=100_000),
+                                           departures=AUTHORS_DEPARTURES))
     return Experiment("table-5.3-authors", "Table 5.3's adaptive run as the authors' script ran it: N_max = 100000, "
                       "Bernstein on the largest variance and range over the components, the step taken even when "
-                      "eps >= |g_k|; strict improvement ratio.", (cfg,), 5,
-                      {"adaptive": _table_5_3().thesis["adaptive"]}, rules="authors")
+                      "eps >= |g_k|; strict improvement ratio.", (cfg,),
+                      thesis={"adaptive": _table_5_3().thesis["adaptive"]}, rules="authors")
 
 
 def _table_5_2_authors() -> Experiment:
     t52 = _table_5_2()
-    configs = tuple(replace(c, step_when_unsafe=True) for c in t52.configs if c.theoretical_range is not None)
+    configs = tuple(replace(c, method=replace(c.method, departures=Departures(unguarded_step=True)))
+                    for c in _theoretical_range_rows(t52))
     return Experiment("table-5.2-authors", "Table 5.2's two theoretical-range rows as the authors' script ran them: "
                       "the range 1280, the step taken even when eps >= |g| (with this range, on the first batch).",
-                      configs, 5, {c.name: t52.thesis[c.name] for c in configs}, rules="authors")
+                      configs, thesis={c.name: t52.thesis[c.name] for c in configs}, rules="authors")
 
 
 def _cartpole_baseline_authors() -> Experiment:
     base = _cartpole_baseline()
-    cfg = replace(base.configs[0], env=_authors_cartpole(doubled=False), update_at_target=True)
+    search = base.configs[0]
+    cfg = replace(search, env=_authors_cartpole(doubled=False),
+                  method=replace(search.method, target=Target(195.0, update=True)))
     return replace(base, name="cartpole-baseline-authors", configs=(cfg,), rules="authors",
                    description="The cart-pole baseline search on the authors' task (12 deg, undiscounted return): "
                                "vanilla G(PO)MDP, alpha = 0.01, N = 4000 from theta = 0 until a batch averages 195, "
@@ -421,21 +381,19 @@ def _cartpole_baseline_authors() -> Experiment:
 
 def _table_5_4_authors(theta_star: bool = False) -> Experiment:
     # Both runs as long as the authors' adaptive run, the window their table averages over.
-    common: dict[str, Any] = dict(env=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET)
-    if theta_star:
-        common["theta0"] = tuple(float(v) for v in cartpole_theta_star())
-    else:
-        common["warm_start"] = "cartpole-baseline-authors"
-    configs = (RunConfig("adaptive", bound="bernstein", empirical_range=True, n_first=1000, n_min=10,
-                         constants="batch", **_AUTHORS_ADAPTIVE, **common),  # type: ignore[arg-type]
-               RunConfig("N=4000", "vanilla", batch_size=4000, alpha=0.01, step="coordinate", **common))
+    start = (dict(theta0=tuple(float(v) for v in cartpole_theta_star())) if theta_star
+             else dict(warm_start="cartpole-baseline-authors"))
+    task = partial(RunConfig, env=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET, **start)
+    configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER, batches=Batches(n_min=10, first=1000),
+                                                departures=replace(AUTHORS_DEPARTURES, batch_constants=True))),
+               task("N=4000", method=Vanilla(4000, FixedStep(0.01, "coordinate"))))
     start = "their own baseline policy (theta_star.npy)" if theta_star else "each seed's cartpole-baseline-authors"
     return Experiment(f"table-5.4-authors{'-theta-star' if theta_star else ''}",
                       f"Table 5.4 as the authors ran it, from {start}: their doubled pole (m l kept at 0.05), 12 deg, "
                       "undiscounted return; adaptive with gamma = 0.9 and R, M_phi measured per batch in c, first N = "
                       "1000, N_min = 10, the maxima over components, unguarded steps; 'vanilla' moving only the "
                       f"largest component by 0.01 g_k; {TABLE_5_4_BUDGET} trajectories each, counted as "
-                      "plot_cartpole.m.", configs, 5, _table_5_4().thesis, "J_hat", "authors")
+                      "plot_cartpole.m.", configs, thesis=_table_5_4().thesis, performance="J_hat", rules="authors")
 
 
 def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
@@ -445,15 +403,9 @@ def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
         if c.env in THESIS_ENVS:
             c = replace(c, env_factory=THESIS_ENVS[c.env])
         if c.warm_start is not None:
-            c = replace(c, warm_start_key=_single_config(registry[c.warm_start]).key())
+            c = replace(c, warm_start_key=registry[c.warm_start].single_config().key())
         configs.append(c)
     return replace(exp, configs=tuple(configs))
-
-
-def _single_config(exp: Experiment) -> RunConfig:
-    if len(exp.configs) != 1:
-        raise ValueError(f"warm_start must name an experiment with one config, {exp.name!r} has {len(exp.configs)}")
-    return exp.configs[0]
 
 
 def _registry() -> dict[str, Experiment]:
@@ -487,114 +439,3 @@ def scaled(exp: Experiment, seeds: int | None = None, budget: int | None = None)
             raise ValueError(f"{name} must be a positive integer, got {value!r}")
     configs = exp.configs if budget is None else tuple(replace(c, budget=budget) for c in exp.configs)
     return replace(exp, configs=configs, seeds=exp.seeds if seeds is None else seeds)
-
-
-# ------------------------------------------------------------------ storage
-def experiment_folder(exp: Experiment | str, root: Path | None = None) -> Path:
-    """The folder of ``exp``'s runs in the store."""
-    return (root or results_dir()) / (exp if isinstance(exp, str) else exp.name)
-
-
-def run_experiment(exp: Experiment | str, seeds: int | None = None, budget: int | None = None, jobs: int = -1,
-                   root: Path | None = None, progress: bool = True) -> dict[str, list[LearningRecord]]:
-    """Run every missing (config, seed) of ``exp`` and return all records by config name.
-
-    Finished runs are loaded, never recomputed (:func:`safepg.runner.run_configs`, which
-    also says how to run on a Dask cluster); a damaged run file is set aside with a
-    warning and its run computed again. A warm-started experiment first runs the
-    experiment it starts from, with the same seeds, and hands each seed's final parameters
-    to the runner. ``jobs`` follows joblib: a positive count, or -1 for every core (-2 all
-    but one, ...).
-    """
-    exp = get_experiment(exp) if isinstance(exp, str) else exp
-    exp = scaled(exp, seeds, budget)
-    # Starting policies first (in parallel), so no two workers compute the same one.
-    starts: dict[str, list[np.ndarray]] = {}
-    for dep in sorted({c.warm_start for c in exp.configs if c.warm_start is not None}):
-        dep_exp = scaled(get_experiment(dep), seeds=exp.seeds)
-        run_experiment(dep_exp, jobs=jobs, root=root, progress=progress)
-        # Seed by seed from its own file, so a missing seed can never shift the others.
-        dep_folder, dep_cfg = experiment_folder(dep_exp, root), _single_config(dep_exp)
-        dep_recs = [stored_run(dep_folder, dep_cfg, k) for k in range(exp.seeds)]
-        if any(r is None for r in dep_recs):
-            raise RuntimeError(f"warm_start {dep!r}: seeds {[k for k, r in enumerate(dep_recs) if r is None]} "
-                               "are not stored; rerun to compute them")
-        starts[dep] = [r.theta_final for r in dep_recs]  # type: ignore[union-attr]
-    by_config = {c.name: starts[c.warm_start] for c in exp.configs if c.warm_start is not None}
-    return run_configs(exp.configs, exp.seeds, experiment_folder(exp, root), starts=by_config, jobs=jobs,
-                       progress=progress, desc=exp.name)
-
-
-def load_experiment(exp: Experiment | str, root: Path | None = None,
-                    on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``exp`` by config name (missing seeds are left out).
-
-    Damaged run files are left out with a warning, or with ``on_damaged="raise"`` named
-    all at once in a :class:`~safepg.store.DamagedRunsError`; :func:`run_experiment`
-    sets them aside and computes their runs again.
-    """
-    exp = get_experiment(exp) if isinstance(exp, str) else exp
-    return load_configs(exp.configs, exp.seeds, experiment_folder(exp, root), on_damaged)
-
-
-# ------------------------------------------------------------------ report
-def _summary(exp: Experiment, cfg: RunConfig, rec: LearningRecord) -> tuple[float, float]:
-    """(Upsilon-bar, improvement ratio) of one run, counted by the experiment's ``rules``."""
-    if exp.rules == "ours":
-        return rec.upsilon_bar(), rec.improvement_ratio(exp.performance)
-    if exp.performance == "J_hat":  # plot_cartpole.m: the batches that end before the budget
-        window = budget_average(rec.batch_size, rec.J_hat, cfg.budget)
-        return window["upsilon_bar"], window["improvement_ratio"]
-    return rec.upsilon_bar(), strict_improvement_ratio(rec.J[:-1])  # J at the batch starts
-
-
-def _authors_output(exp: Experiment, cfg: RunConfig) -> dict[str, Any] | None:
-    """The authors' own output for ``cfg`` of an authors-settings experiment (their files, recomputed)."""
-    base = authors.cartpole_runs()["baseline"] if exp.rules == "authors" else None
-    out = {"table-5.1-authors": lambda: authors.table_5_1().get((cfg.sigma, cfg.batch_size, cfg.alpha)),
-           "table-5.3-authors": lambda: authors.table_5_3().get(cfg.name),
-           "cartpole-baseline-authors": lambda: {"iterations": base.iterations, "J_hat_final": base["J_hat"][-1]},
-           "table-5.4-authors": lambda: authors.table_5_4()["adaptive" if cfg.algorithm == "adaptive" else "fixed"]}
-    got = out.get(exp.name.removesuffix("-theta-star"), lambda: None)() if base is not None else None
-    return None if got is None else {k: np.asarray(v).tolist() for k, v in got.items()}
-
-
-def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | None = None,
-           root: Path | None = None) -> dict[str, Any]:
-    """One JSON-ready object per configuration, with the thesis's printed values beside ours (and,
-    for the authors' settings, ``authors_output``: their own raw output recomputed)."""
-    exp = get_experiment(exp) if isinstance(exp, str) else exp
-    records = load_experiment(exp, root) if records is None else records
-    rows = []
-    closed_form = exp.performance == "J"
-    for c in exp.configs:
-        recs = records.get(c.name, [])
-        j_at: dict[str, float] = {}
-        for T in CHECKPOINTS if closed_form else ():
-            vals = [r.J_at((T,)).get(str(T)) for r in recs]
-            if vals and all(v is not None for v in vals):
-                j_at[str(T)] = float(np.mean(vals))
-        # Components of theta that any seed's run changed (the thesis's remarks on which
-        # entries the coordinate step leaves alone).
-        updated = sorted({int(i) for r in recs for i in np.flatnonzero(r.theta[-1] != r.theta[0])})
-        rows.append({
-            "name": c.name, "estimator": c.estimator, "bound": c.bound,
-            "empirical_range": c.empirical_range, "delta": c.delta, "sigma": c.sigma,
-            "algorithm": c.algorithm, "budget": c.budget, "batch_size": c.batch_size, "alpha": c.alpha,
-            "seeds": len(recs),
-            "upsilon_bar": seed_summary95(_summary(exp, c, r)[0] for r in recs),
-            "improvement_ratio": seed_summary95(_summary(exp, c, r)[1] for r in recs),
-            "theta_moved": max((float(np.max(np.abs(r.theta_final - r.theta[0]))) for r in recs), default=None),
-            "improvement_ratio_on": exp.performance,
-            "rules": exp.rules,
-            "J_at": j_at,
-            "J_final": float(np.mean([r.J[-1] for r in recs])) if recs and closed_form else None,
-            "J_hat_final": float(np.mean([r.J_hat[-1] for r in recs])) if recs else None,
-            "iterations": float(np.mean([r.iterations for r in recs])) if recs else None,
-            "theta_final": np.mean([r.theta_final for r in recs], axis=0).tolist() if recs else None,
-            "components_updated": updated,
-            "diverged": sum(r.diverged for r in recs),
-            "thesis": exp.thesis.get(c.name),
-            "authors_output": _authors_output(exp, c),
-        })
-    return {"experiment": exp.name, "configs": rows}

@@ -80,10 +80,12 @@ def figure_5_1(records: Records, configs: Sequence) -> Figure:
     """Figure 5.1: expected performance over trajectories, Chebyshev's bound, several delta;
     G(PO)MDP solid, REINFORCE dashed; seed mean with the min-max band."""
     fig, ax = plt.subplots(figsize=(7, 4))
-    deltas = sorted({c.delta for c in configs})
-    labels = {c.name: f"{plotting.ESTIMATOR_LABELS[c.estimator]}, $\\delta$ = {c.delta}" for c in configs}
-    styles = {c.name: {**plotting.estimator_style(c.estimator), "color": plotting.delta_color(c.delta, deltas)}
-              for c in configs}
+    deltas = sorted({c.method.error.delta for c in configs})
+    labels, styles = {}, {}
+    for c in configs:
+        estimator, delta = c.method.gradient.estimator, c.method.error.delta
+        labels[c.name] = f"{plotting.ESTIMATOR_LABELS[estimator]}, $\\delta$ = {delta}"
+        styles[c.name] = {**plotting.estimator_style(estimator), "color": plotting.delta_color(delta, deltas)}
     _performance_panel(ax, records, labels, styles)
     fig.tight_layout()
     return fig
@@ -93,8 +95,9 @@ def figure_5_2(records: Records, configs: Sequence) -> Figure:
     """Figure 5.2: expected performance over trajectories for the concentration bounds
     (G(PO)MDP, delta = 0.95)."""
     fig, ax = plt.subplots(figsize=(7, 4))
-    labels = {c.name: plotting.bound_label(c.bound, c.empirical_range) for c in configs}
-    styles = {c.name: {"color": plotting.bound_color(c.bound, c.empirical_range)} for c in configs}
+    errors = {c.name: c.method.error for c in configs}
+    labels = {name: plotting.bound_label(e.bound, e.empirical_range) for name, e in errors.items()}
+    styles = {name: {"color": plotting.bound_color(e.bound, e.empirical_range)} for name, e in errors.items()}
     _performance_panel(ax, records, labels, styles)
     fig.tight_layout()
     return fig
@@ -106,8 +109,9 @@ def figure_batch_sizes(records: Records, configs: Sequence, log: bool = True) ->
     for c in configs:
         mean, lo, hi = mean_band(by_iteration(records[c.name], "batch_size"))
         it = np.arange(1, mean.size + 1)
-        color = plotting.bound_color(c.bound, c.empirical_range)
-        ax.plot(it, mean, color=color, label=plotting.bound_label(c.bound, c.empirical_range))
+        e = c.method.error
+        color = plotting.bound_color(e.bound, e.empirical_range)
+        ax.plot(it, mean, color=color, label=plotting.bound_label(e.bound, e.empirical_range))
         ax.fill_between(it, lo, hi, color=color, alpha=0.2, linewidth=0)
     ax.set_xlabel("iteration")
     ax.set_ylabel("batch size $N$")

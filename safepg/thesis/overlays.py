@@ -149,7 +149,9 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
     closed-form J of the
     policy that generated trajectory T; ``values``, each seed's) and the authors' five-run mean,
     on their grid of T."""
-    curve = authors.figure51_52_curves()[(config.estimator, config.bound, config.empirical_range, config.delta)]
+    error = config.method.error
+    curve = authors.figure51_52_curves()[(config.method.gradient.estimator, error.bound, error.empirical_range,
+                                          error.delta)]
     grid = curve["trajectories"].astype(np.int64)
     values = performance_on_grid(records[config.name], grid)
     mean, lo, hi = seed_band95(values, runs=FIGURES_51_52_RUNS)
@@ -174,13 +176,14 @@ def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs:
     """Figure 5.1 (Chebyshev, each delta): our ``table-5.2`` runs (mean and 95% prediction band for a
     five-run mean over
     seeds, in colour) under the authors' five-run means (black, dashed); one panel per estimator."""
-    estimators = [e for e in ("gpomdp", "reinforce") if any(c.estimator == e for c in configs)]
+    estimators = [e for e in ("gpomdp", "reinforce") if any(c.method.gradient.estimator == e for c in configs)]
     fig, axes = plt.subplots(1, len(estimators), figsize=(7, 3.6), squeeze=False, sharey=True)
-    deltas = sorted({c.delta for c in configs})
+    deltas = sorted({c.method.error.delta for c in configs})
     for ax, est in zip(axes[0], estimators):
-        mine = [c for c in configs if c.estimator == est]
-        _figure51_52_panel(ax, records, mine, {c.name: plotting.delta_color(c.delta, deltas) for c in mine},
-                           {c.name: f"δ = {c.delta}" for c in mine})
+        mine = [c for c in configs if c.method.gradient.estimator == est]
+        delta = {c.name: c.method.error.delta for c in mine}
+        _figure51_52_panel(ax, records, mine, {n: plotting.delta_color(d, deltas) for n, d in delta.items()},
+                           {n: f"δ = {d}" for n, d in delta.items()})
         ax.set_title(plotting.ESTIMATOR_LABELS[est], fontsize="small")
         if ylim is not None:
             ax.set_ylim(*ylim)
@@ -193,9 +196,10 @@ def figure_5_2_overlay(records: Mapping[str, Sequence[LearningRecord]], configs:
     """Figure 5.2 (G(PO)MDP, delta = 0.95, each bound): our ``table-5.2`` runs (mean and 95%
     prediction band for a five-run mean, in colour) under the authors' five-run means (black, dashed)."""
     fig, ax = plt.subplots(figsize=(7, 3.8))
+    errors = {c.name: c.method.error for c in configs}
     _figure51_52_panel(ax, records, configs,
-                       {c.name: plotting.bound_color(c.bound, c.empirical_range) for c in configs},
-                       {c.name: plotting.bound_label(c.bound, c.empirical_range) for c in configs})
+                       {n: plotting.bound_color(e.bound, e.empirical_range) for n, e in errors.items()},
+                       {n: plotting.bound_label(e.bound, e.empirical_range) for n, e in errors.items()})
     if ylim is not None:
         ax.set_ylim(*ylim)
     fig.tight_layout()

@@ -41,7 +41,8 @@ import numpy as np
 from tqdm import tqdm
 
 from safepg import runner
-from safepg.thesis.experiments import EXPERIMENTS, experiment_folder, get_experiment, run_experiment, scaled
+from safepg.thesis.experiment_store import experiment_folder, run_experiment
+from safepg.thesis.experiments import EXPERIMENTS, get_experiment, scaled
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
 BOOK = Path(__file__).resolve().parents[2] / "book"
@@ -123,8 +124,8 @@ def _experiment_names(tree: ast.AST) -> list[str]:
 def chapter_requests(notebook: Path) -> list[Task]:
     """What one chapter's cells compute and store, in the order of its cells."""
     from safepg.thesis.cartpole_sweep import baseline_experiments
-    from safepg.thesis.experiments import SWEEP_SEEDS
     from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS
+    from safepg.thesis.sweep_settings import SWEEP_SEEDS
 
     chapter, tasks = notebook.stem, []
     for tree in _code_cells(notebook):
@@ -386,7 +387,7 @@ def safety_plan(root: Path) -> list[tuple[str, Any, np.ndarray, tuple[int, ...]]
     table-5.4 experiments are read from ``root``.
     """
     from safepg.thesis import authors
-    from safepg.thesis.experiments import load_experiment
+    from safepg.thesis.experiment_store import load_experiment
     from safepg.thesis.safety_store import table_5_4_runs
 
     records = {name: load_experiment(name, root)

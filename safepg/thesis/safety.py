@@ -34,8 +34,10 @@ import numpy as np
 from safepg import portable
 from safepg.envs.cartpole import CartPole
 from safepg.learning import LearningRecord
+from safepg.options import Adaptive
 from safepg.policies import LinearGaussianPolicy
 from safepg.runner import RunConfig
+from safepg.tasks import task_hooks
 
 
 def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
@@ -44,37 +46,30 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
     Returns one row per assumption: ``assumption`` (its words), ``holds`` (bool) and
     ``why`` (the setting that decides it).
     """
-    if cfg.algorithm != "adaptive":
+    method = cfg.method
+    if not isinstance(method, Adaptive):
         raise ValueError(f"cfg must be an adaptive run, got algorithm={cfg.algorithm!r}")
-    constants = cfg.constants or "bounds"
-    statistics = cfg.statistics or "component"
     task = cfg.make_env()
     simulated, written = task.gamma, getattr(task, "constants_gamma", None)
     one_discount = written is None or written == simulated
+    from_bounds, guarded, per_component = method.departures.assumptions()
+    empirical = method.error.bound in ("bernstein", "hoeffding") and method.error.empirical_range
+    first = method.batches.first
     rows = [
-        {"assumption": "c from bounds of |r| and |phi| (Assumption 4.2.1)",
-         "holds": constants == "bounds",
-         "why": "R and M_phi are the task's bounds" if constants == "bounds"
-         else "R and M_phi are measured on each batch, so c changes with the batch"},
+        from_bounds._asdict(),
         {"assumption": "c written for the discount the simulator optimises",
          "holds": one_discount,
          "why": f"gamma = {simulated:g} in both" if one_discount
          else f"the return is simulated with gamma = {simulated:g}, c is written with {written:g}"},
-        {"assumption": "step only where eps < |g_k| (Assumption 4.2.7)",
-         "holds": not cfg.step_when_unsafe,
-         "why": "no step when eps >= |g_k|" if not cfg.step_when_unsafe
-         else "the step formula is applied even when eps >= |g_k|"},
-        {"assumption": "eps a per-component error bound",
-         "holds": statistics == "component",
-         "why": "variance and range of component k" if statistics == "component"
-         else "the largest variance and range over the components"},
+        guarded._asdict(),
+        per_component._asdict(),
         {"assumption": "eps from a range bound, not the batch's own range",
-         "holds": not (cfg.bound in ("bernstein", "hoeffding") and cfg.empirical_range),
-         "why": "theoretical range" if not cfg.empirical_range else "the empirical range of the batch"},
+         "holds": not empirical,
+         "why": "theoretical range" if not method.error.empirical_range else "the empirical range of the batch"},
         {"assumption": "batch sizes as Algorithm 4.1 sets them (N_min, then N* of the bound)",
-         "holds": cfg.n_first is None,
-         "why": "the first batch is the algorithm's N_min, every later one the bound's N*" if cfg.n_first is None
-         else f"the first batch is fixed at {cfg.n_first}, outside the algorithm"},
+         "holds": first is None,
+         "why": "the first batch is the algorithm's N_min, every later one the bound's N*" if first is None
+         else f"the first batch is fixed at {first}, outside the algorithm"},
     ]
     return rows
 
@@ -390,7 +385,7 @@ def _paired(env: Any, theta_a: np.ndarray, theta_b: np.ndarray, sigma: float, n:
     out, steps = [], 0
     for theta in (theta_a, theta_b):
         th = np.asarray(theta, dtype=float)
-        policy = LinearGaussianPolicy(th.reshape(getattr(env, "action_dim", getattr(env, "dim", 1)), -1), sigma)
+        policy = LinearGaussianPolicy(th.reshape(task_hooks(env).action_dim, -1), sigma)
         if isinstance(env, CartPole):
             # The episode lengths alone: no baseline to form (the returns are the same either way).
             lengths = np.asarray(env.gradient_batch(policy, n, seed, baseline=False)[1])

@@ -14,13 +14,16 @@ ticks every box (and starts from their theta*), and theta_xdot moves.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from safepg.envs.cartpole import CartPole
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import learn
+from safepg.options import Adaptive, ErrorModel, Vanilla
 from safepg.thesis.authors import cartpole_theta_star
 from safepg.thesis.experiments import AUTHORS_DOUBLED, get_experiment
 from safepg.thesis.explorers.ch5_live import (
@@ -35,6 +38,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
+from safepg.thesis.explorers.js_tasks import learner_options
 
 #: Trajectories per run offered; small, so that a run takes seconds in a browser.
 BUDGETS = (10_000, 20_000, 50_000, 100_000, 200_000)
@@ -43,16 +47,32 @@ FROZEN = 1e-6
 THETA_NAMES = ("theta_x", "theta_xdot", "theta_beta", "theta_betadot")
 THETA_COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
 ADAPTIVE_COLOR, VANILLA_COLOR = "#9467bd", "#444444"
-#: The authors' settings, one checkbox each: (name, label, task fields, adaptive_pg options).
-SETTINGS: tuple[tuple[str, str, dict[str, Any], dict[str, Any]], ...] = (
+
+
+def _depart(name: str, method: Adaptive) -> Adaptive:
+    """``method`` with the departure ``name`` taken."""
+    return replace(method, departures=replace(method.departures, **{name: True}))
+
+
+def _first_batch_1000(method: Adaptive) -> Adaptive:
+    """The authors' cart-pole batches: a first batch of 1000, N_min 10."""
+    return replace(method, batches=replace(method.batches, n_min=10, first=1000))
+
+
+def _same(method: Adaptive) -> Adaptive:
+    return method
+
+
+#: The authors' settings, one checkbox each: (name, label, task fields, the change to Algorithm 4.1).
+SETTINGS: tuple[tuple[str, str, dict[str, Any], Callable[[Adaptive], Adaptive]], ...] = (
     ("gamma09", "gamma = 0.9 in c (undiscounted return)",
-     {"gamma": AUTHORS_DOUBLED["gamma"], "constants_gamma": AUTHORS_DOUBLED["constants_gamma"]}, {}),
-    ("batch_constants", "R and M_phi measured per batch", {}, {"constants": "batch"}),
-    ("max_stats", "maxima over components", {}, {"statistics": "max"}),
-    ("unguarded", "step even when eps >= |g_k|", {}, {"step_when_unsafe": True}),
-    ("first1000", "first batch 1000 (N_min 10)", {}, {"n_first": 1000, "n_min": 10}),
-    ("deg12", "12 deg (not 41.8 deg)", {"angle_threshold_deg": AUTHORS_DOUBLED["angle_threshold_deg"]}, {}),
-    ("ml005", "m l kept at 0.05", {"polemass_length": AUTHORS_DOUBLED["polemass_length"]}, {}),
+     {"gamma": AUTHORS_DOUBLED["gamma"], "constants_gamma": AUTHORS_DOUBLED["constants_gamma"]}, _same),
+    ("batch_constants", "R and M_phi measured per batch", {}, partial(_depart, "batch_constants")),
+    ("max_stats", "maxima over components", {}, partial(_depart, "maxima")),
+    ("unguarded", "step even when eps >= |g_k|", {}, partial(_depart, "unguarded_step")),
+    ("first1000", "first batch 1000 (N_min 10)", {}, _first_batch_1000),
+    ("deg12", "12 deg (not 41.8 deg)", {"angle_threshold_deg": AUTHORS_DOUBLED["angle_threshold_deg"]}, _same),
+    ("ml005", "m l kept at 0.05", {"polemass_length": AUTHORS_DOUBLED["polemass_length"]}, _same),
 )
 TASK_BOXES = tuple(name for name, _, fields, _ in SETTINGS if fields)
 
@@ -76,29 +96,28 @@ def cartpole_task(p: Mapping[str, Any]) -> CartPole:
     return CartPole.thesis_doubled(**task_fields(p))
 
 
-def adaptive_options(p: Mapping[str, Any]) -> dict[str, Any]:
-    """The :func:`~safepg.learning.adaptive_pg` keyword arguments of the controls ``p`` (besides
-    the task, theta_0, sigma, seed): ``table-5.4``'s adaptive run with the ticked boxes' options."""
-    out: dict[str, Any] = dict(bound="bernstein", empirical_range=True, delta=float(p["delta"]),
-                               budget=int(p["budget"]), n_min=100, n_first=None, constants="bounds",
-                               statistics="component", step_when_unsafe=False)
-    for name, _, _, options in SETTINGS:
+def adaptive_method(p: Mapping[str, Any]) -> Adaptive:
+    """Algorithm 4.1 as the controls ``p`` set it: ``table-5.4``'s adaptive run (Bernstein with
+    the empirical range) at the control's delta, with the ticked boxes' changes."""
+    method = replace(get_experiment("table-5.4").config("adaptive").method,
+                     error=ErrorModel("bernstein", float(p["delta"]), "empirical"))
+    for name, _, _, change in SETTINGS:
         if p[name]:
-            out.update(options)
-    return out
+            method = change(method)
+    return method
 
 
-def vanilla_options(p: Mapping[str, Any]) -> dict[str, Any]:
-    """The :func:`~safepg.learning.vanilla_pg` keyword arguments: ``table-5.4``'s fixed step."""
-    cfg = get_experiment("table-5.4").config("N=4000")
-    return dict(batch_size=cfg.batch_size, alpha=cfg.alpha, step=cfg.step, bound="bernstein", empirical_range=True,
-                delta=float(p["delta"]), budget=int(p["budget"]), stop_on_divergence=True)
+def vanilla_method() -> Vanilla:
+    """``table-5.4``'s fixed-step method (N = 4000, alpha = 0.01), whatever the boxes."""
+    method = get_experiment("table-5.4").config("N=4000").method
+    assert isinstance(method, Vanilla)
+    return method
 
 
 def stored_baseline() -> np.ndarray | None:
     """Seed 0's final theta of the stored ``cartpole-baseline`` run, or None if it is not stored."""
     try:
-        from safepg.thesis.experiments import load_experiment
+        from safepg.thesis.experiment_store import load_experiment
 
         recs = load_experiment("cartpole-baseline").get("baseline") or []
     except Exception:  # noqa: BLE001 (no store, or a damaged one: the explorer offers theta* alone)
@@ -226,12 +245,16 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
     for k in range(2 ** len(TASK_BOXES)):
         p = {name: bool(k >> i & 1) for i, name in enumerate(TASK_BOXES)}
         tasks[task_key(p)] = cartpole_task_data(cartpole_task(p))
-    van = vanilla_options({"delta": 0.95, "budget": 0})
+    van = learner_options(vanilla_method())
+    text = adaptive_method({"delta": 0.95, **{name: False for name, *_ in SETTINGS}})
+    base = learner_options(text)
     data = {"tasks": tasks, "starts": starts, "points": CURVE_POINTS, "frozen": FROZEN,
             "theta_names": list(THETA_NAMES), "theta_colors": list(THETA_COLORS), "task_boxes": list(TASK_BOXES),
-            "settings": {name: options_ for name, _, _, options_ in SETTINGS},
-            "vanilla": {"batchSize": van["batch_size"], "alpha": van["alpha"], "step": van["step"]},
-            "vanilla_label": f"fixed step (N = {van['batch_size']}, alpha = {van['alpha']:g})"}
+            # Each box's options under the page learner's names, as far as they differ from the text's.
+            "settings": {name: {k: v for k, v in learner_options(change(text)).items() if base[k] != v}
+                         for name, _, _, change in SETTINGS},
+            "vanilla": {k: van[k] for k in ("batchSize", "alpha", "step")},
+            "vanilla_label": f"fixed step (N = {van['batchSize']}, alpha = {van['alpha']:g})"}
 
     def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:
         task, theta0, sigma = cartpole_task(p), np.asarray(starts[str(p["start"])]), float(p["sigma"])
@@ -243,12 +266,12 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
             return lambda used, total: progress((k * budget + used) / (2 * budget),
                                                 f"{label}: {used:,} / {total:,} trajectories")
 
-        kw = adaptive_options(p)
-        rec = adaptive_pg(task, theta0, sigma, rng=np.random.default_rng([seed, 0]),
-                          progress=report(0, "Algorithm 4.1"), **kw)
-        traces = {"adaptive": record_trace(rec, record_c(rec, kw["constants"]))}
-        traces["vanilla"] = record_trace(vanilla_pg(task, theta0, sigma, rng=np.random.default_rng([seed, 1]),
-                                                    progress=report(1, "fixed step"), **vanilla_options(p)))
+        method = adaptive_method(p)
+        rec = learn(task, method, theta0, sigma, budget=budget, rng=np.random.default_rng([seed, 0]),
+                    progress=report(0, "Algorithm 4.1"))
+        traces = {"adaptive": record_trace(rec, record_c(rec, method.departures.batch_constants))}
+        traces["vanilla"] = record_trace(learn(task, vanilla_method(), theta0, sigma, budget=budget,
+                                               rng=np.random.default_rng([seed, 1]), progress=report(1, "fixed step")))
         out = cartpole_result(p, traces, data)
         return kernel_text(out)
 
@@ -273,5 +296,5 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
     return ex
 
 
-__all__ = ["BUDGETS", "FROZEN", "SETTINGS", "TASK_BOXES", "adaptive_options", "cartpole_explorer", "cartpole_result",
-           "cartpole_task", "settings_line", "stored_baseline", "task_fields", "task_key", "vanilla_options"]
+__all__ = ["BUDGETS", "FROZEN", "SETTINGS", "TASK_BOXES", "adaptive_method", "cartpole_explorer", "cartpole_result",
+           "cartpole_task", "settings_line", "stored_baseline", "task_fields", "task_key", "vanilla_method"]

@@ -84,12 +84,12 @@ def fixed(v: float | None, digits: int) -> str:
     return "-" if v is None or not math.isfinite(v) else f"{v:.{digits}f}"
 
 
-def record_c(rec: LearningRecord, constants: str = "bounds") -> list[float | None]:
+def record_c(rec: LearningRecord, batch_constants: bool = False) -> list[float | None]:
     """The penalty constant c used at each iteration of an adaptive record: the bound-based
-    ``config["c"]``, or with ``constants="batch"`` the batch's c, recovered from the step
+    ``config["c"]``, or with ``batch_constants`` (R and M_phi measured per batch) the batch's c, recovered from the step
     alpha = (g - eps)^2 / (2 c (g + eps)^2) on the updated component (None where alpha = 0)."""
     c0 = rec.config.get("c")
-    if constants != "batch":
+    if not batch_constants:
         return [finite(c0)] * rec.iterations if c0 is not None else [None] * rec.iterations
     out: list[float | None] = []
     for i in range(rec.iterations):

@@ -113,17 +113,17 @@ def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, the
             "emp_range": srange, "points": 200, "accent": plotting.ACCENT, "muted": plotting.MUTED}
 
     def bound_for(p: dict[str, Any]) -> tuple[ErrorBound, float]:
-        k = TaskConstants.from_task(env, p["sigma"])
+        constants = TaskConstants.from_task(env, p["sigma"])
         S = float(np.interp(p["sigma"], sigmas, svar))
         er = float(np.interp(p["sigma"], sigmas, srange))
         b = p["bound"]
-        bd = {"chebyshev-gpomdp": lambda: chebyshev(p["delta"], gpomdp_variance_factor(k)),
-              "chebyshev-reinforce": lambda: chebyshev(p["delta"], reinforce_variance_factor(k)),
-              "hoeffding": lambda: hoeffding(p["delta"], gradient_range_bound(k)),
+        bd = {"chebyshev-gpomdp": lambda: chebyshev(p["delta"], gpomdp_variance_factor(constants)),
+              "chebyshev-reinforce": lambda: chebyshev(p["delta"], reinforce_variance_factor(constants)),
+              "hoeffding": lambda: hoeffding(p["delta"], gradient_range_bound(constants)),
               "hoeffding-er": lambda: hoeffding(p["delta"], er),
-              "bernstein": lambda: bernstein(p["delta"], S, gradient_range_bound(k)),
+              "bernstein": lambda: bernstein(p["delta"], S, gradient_range_bound(constants)),
               "bernstein-er": lambda: bernstein(p["delta"], S, er)}[b]()
-        return bd, penalty_constant(k)
+        return bd, penalty_constant(constants)
 
     def compute_py(p: dict[str, Any]) -> dict[str, Any]:
         bd, c = bound_for(p)

@@ -17,6 +17,7 @@ import numpy as np
 
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
+from safepg.options import Adaptive, FixedStep, Method, SafeStep
 from safepg.thesis.explorers.component import static_text
 
 #: The learner's files in the order they must be concatenated (each extends the ones before).
@@ -97,4 +98,39 @@ def cartpole_task_data(task: CartPole) -> dict[str, Any]:
             "initBound": float(task.init_bound), "integrator": task.integrator}
 
 
-__all__ = ["LEARNER_FILES", "cartpole_task_data", "learner_sources", "lqg_task_data"]
+def learner_options(method: Method) -> dict[str, Any]:
+    """A method's options under the names of the page learner's run configuration (``vector_run.js``).
+
+    The one place where safepg's option objects meet the JavaScript's names: the learner's
+    ``constants: "batch"``, ``statistics: "max"`` and ``stepWhenUnsafe`` are the
+    :class:`~safepg.options.Departures`, ``nFirst`` is ``Batches.first``, ``alpha: null`` a
+    :class:`~safepg.options.SafeStep`.
+
+    Parameters
+    ----------
+    method : Adaptive or Vanilla
+
+    Returns
+    -------
+    dict
+        ``algorithm``, ``estimator``, ``baseline``, ``score``, ``bound``, ``empiricalRange``,
+        ``theoreticalRange``, ``delta``; then ``nMin``, ``nMax``, ``nFirst``, ``constants``,
+        ``statistics``, ``stepWhenUnsafe`` (adaptive) or ``batchSize``, ``alpha``, ``step`` (vanilla).
+    """
+    g = method.gradient
+    out: dict[str, Any] = {"estimator": g.estimator, "baseline": g.baseline, "score": g.score_action}
+    if isinstance(method, Adaptive):
+        e, b, d = method.error, method.batches, method.departures
+        return {"algorithm": "adaptive", **out, "bound": e.bound, "empiricalRange": e.empirical_range,
+                "theoreticalRange": e.theoretical_range, "delta": e.delta, "nMin": b.n_min, "nMax": b.n_max,
+                "nFirst": b.first, "constants": "batch" if d.batch_constants else "bounds",
+                "statistics": "max" if d.maxima else "component", "stepWhenUnsafe": d.unguarded_step}
+    step = method.step
+    e = step.error if isinstance(step, SafeStep) else None
+    return {"algorithm": "vanilla", **out, "bound": e.bound if e else "chebyshev",
+            "empiricalRange": bool(e and e.empirical_range), "theoreticalRange": e.theoretical_range if e else None,
+            "delta": e.delta if e else 0.95, "batchSize": method.batch_size,
+            "alpha": step.alpha if isinstance(step, FixedStep) else None, "step": step.kind}
+
+
+__all__ = ["LEARNER_FILES", "cartpole_task_data", "learner_options", "learner_sources", "lqg_task_data"]

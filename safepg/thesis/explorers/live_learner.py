@@ -42,7 +42,8 @@ import numpy as np
 
 from safepg import portable
 from safepg.envs.lqg import LQG
-from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.learning import LearningRecord, learn
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, Vanilla
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band, performance_on_grid
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
@@ -121,8 +122,9 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
             ups.append(portable.fsum_mean(r.J_hat, weights=w))  # exact sums, not BLAS (safepg.portable)
             its.append(int(np.count_nonzero(s < B)))
         per_budget[str(B)] = {"upsilon_bar": _round([np.mean(ups)])[0], "iterations": float(np.mean(its))}
-    return {"estimator": cfg.estimator, "bound": cfg.bound + ("-er" if cfg.empirical_range else ""),
-            "delta": cfg.delta, "score": cfg.score_action, "seeds": len(recs), "name": cfg.name,
+    m = cfg.method
+    return {"estimator": m.gradient.estimator, "bound": m.error.bound + ("-er" if m.error.empirical_range else ""),
+            "delta": m.error.delta, "score": m.gradient.score_action, "seeds": len(recs), "name": cfg.name,
             "iteration": (keep + 1).tolist(), "start": _round(start_mean[keep]),
             "batch_size": _round(n[keep]), "alpha": _round(a[keep]),
             "J": _round(mean_band(performance_on_grid(recs, grid))[0]), "budgets": per_budget}
@@ -131,9 +133,11 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
 def _matches_1d_table(cfg: Any) -> bool:
     """A stored configuration the live learner can rerun: Algorithm 4.1 on the 1-D LQG from
     theta_0 = 0, sigma = 1, with the default batch limits, range and a long enough budget."""
-    return (getattr(cfg, "algorithm", None) == "adaptive" and cfg.env == "lqg1d" and tuple(cfg.theta0) == (0.0,)
-            and cfg.sigma == 1.0 and cfg.baseline and cfg.n_min == 100 and cfg.n_max == 500_000
-            and cfg.theoretical_range is None and cfg.budget >= BUDGETS[-1] and cfg.warm_start is None)
+    m = cfg.method
+    return (isinstance(m, Adaptive) and cfg.env == "lqg1d" and tuple(cfg.theta0) == (0.0,)
+            and cfg.sigma == 1.0 and m.gradient.baseline and m.batches == Batches()
+            and m.departures == Departures() and m.error.theoretical_range is None and cfg.budget >= BUDGETS[-1]
+            and cfg.warm_start is None)
 
 
 def overlay_key(p: Mapping[str, Any]) -> str:
@@ -328,8 +332,7 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
     """
     budget, seed = int(p["budget"]), int(round(float(p["seed"])))
     bound = str(p["bound"])
-    common = dict(estimator=p["estimator"], baseline=p["baseline"] == "on", budget=budget,
-                  score_action=p["score"])
+    gradient = Gradient(p["estimator"], p["baseline"] == "on", p["score"])
     runs = 1 if p["vanilla_n"] == "off" else 2
 
     def report(k: int, label: str) -> Callable[[int, int], None] | bool:
@@ -339,15 +342,13 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         return lambda used, total: progress((k * budget + used) / (runs * budget),
                                             f"{label}: {used:,} / {total:,} trajectories")
 
-    recs = {"adaptive": adaptive_pg(env, 0.0, float(p["sigma"]), bound=bound.replace("-er", ""),
-                                    delta=float(p["delta"]), empirical_range=bound.endswith("-er"),
-                                    rng=np.random.default_rng(seed), progress=report(0, "Algorithm 4.1"),
-                                    **common)}
+    error = ErrorModel(bound.removesuffix("-er"), float(p["delta"]), "empirical" if bound.endswith("-er") else "lemma")
+    recs = {"adaptive": learn(env, Adaptive(gradient, error), 0.0, float(p["sigma"]), budget=budget,
+                              rng=np.random.default_rng(seed), progress=report(0, "Algorithm 4.1"))}
     if p["vanilla_n"] != "off":
-        recs["vanilla"] = vanilla_pg(env, 0.0, float(p["sigma"]), batch_size=int(p["vanilla_n"]),
-                                     alpha=float(p["vanilla_alpha"]), stop_on_divergence=True,
-                                     rng=np.random.default_rng([seed, 1]), progress=report(1, "vanilla PG"),
-                                     **common)
+        recs["vanilla"] = learn(env, Vanilla(int(p["vanilla_n"]), FixedStep(float(p["vanilla_alpha"])), gradient),
+                                0.0, float(p["sigma"]), budget=budget, rng=np.random.default_rng([seed, 1]),
+                                progress=report(1, "vanilla PG"))
     plots: dict[str, Any] = {"N": {"series": []}, "J": {"series": []}, "alpha": {"series": []}}
     values: dict[str, Any] = {"done": True}
     key = overlay_key(p)

@@ -1,7 +1,7 @@
 r"""Section 5.2 live: the 2-D LQG explorers, computed in the reader's browser (see :mod:`.ch5_live`).
 
 :func:`lqg2d_steps_explorer` (Figures 5.5-5.6): the scalar adaptive step of [24] against the
-coordinate step Lambda* (``vanilla_pg`` with ``alpha=None``, ``step="scalar"``/``"coordinate"``,
+coordinate step Lambda* (``vanilla_pg`` with ``SafeStep("scalar")``/``SafeStep("coordinate")``,
 a fixed N as ``figures-5.5-5.6`` configures it: G(PO)MDP, Chebyshev, delta = 0.95, N = 2000),
 drawing the diagonal gains theta_11 and theta_22 and J over the updates.
 
@@ -18,12 +18,14 @@ Both run on ``lqg2d-gamma0.9``, the discount the Section 5.2 experiments use, fr
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from safepg.envs.lqg import LQG
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import learn
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Method, SafeStep, Vanilla
 from safepg.thesis.experiments import LQG2D_GAMMA, get_experiment
 from safepg.thesis.explorers.ch5_live import (
     BOUND_CHOICES,
@@ -39,6 +41,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
+from safepg.thesis.explorers.js_tasks import learner_options
 
 #: Budgets offered (trajectories per run); the experiments ran 3*10^7.
 BUDGETS = (30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
@@ -49,8 +52,15 @@ STEP_LABELS = {"scalar": "scalar step [24]", "coordinate": "coordinate step"}
 STEP_COLORS = {"scalar": "#1f77b4", "coordinate": "#d62728"}
 FIXED_RUNS = (("N=1000", 1000, "#444444"), ("N=100", 100, "#2ca02c"))
 ADAPTIVE_COLOR = "#9467bd"
-#: The authors' 2-D adaptive settings (table-5.3-authors).
-AUTHORS_2D = {"statistics": "max", "step_when_unsafe": True, "n_first": 100, "n_max": 100_000}
+
+
+def authors_2d() -> Adaptive:
+    """The authors' 2-D adaptive run (``table-5.3-authors``): the maxima over components, the
+    unguarded step, N_max = 100000, and the first batch of 100 their script hard-codes (the same
+    size as N_min here, so ``table-5.3-authors`` leaves it to the algorithm)."""
+    method = get_experiment("table-5.3-authors").config("adaptive").method
+    assert isinstance(method, Adaptive)
+    return replace(method, batches=replace(method.batches, first=100))
 
 
 def lqg2d_env() -> LQG:
@@ -72,9 +82,10 @@ def _task_or_none(env: LQG) -> dict[str, Any] | None:
         return {"kind": "lqg", "missing": "safepg.thesis.explorers.js_tasks"}
 
 
-def _bound(p: Mapping[str, Any]) -> tuple[str, bool]:
+def _error(p: Mapping[str, Any]) -> ErrorModel:
+    """The bound control (``"bernstein-er"``: with the empirical range) at the delta control."""
     b = str(p["bound"])
-    return b.removesuffix("-er"), b.endswith("-er")
+    return ErrorModel(b.removesuffix("-er"), float(p["delta"]), "empirical" if b.endswith("-er") else "lemma")
 
 
 def _seed(p: Mapping[str, Any]) -> int:
@@ -89,12 +100,10 @@ def _reporter(progress: Reporter | None, k: int, runs: int, budget: int, label: 
 
 
 # ---------------------------------------------------------------- Figures 5.5-5.6
-def steps_configs(p: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """The safepg keyword arguments of each run of the steps explorer (the page's ``configs``)."""
-    bound, er = _bound(p)
-    return {step: dict(batch_size=int(p["n"]), alpha=None, step=step, bound=bound, empirical_range=er,
-                       delta=float(p["delta"]), budget=int(p["budget"]), stop_on_divergence=True)
-            for step in ("scalar", "coordinate")}
+def steps_configs(p: Mapping[str, Any]) -> dict[str, Vanilla]:
+    """The method of each run of the steps explorer (the page's ``configs``): the scalar and the
+    coordinate safe step at the fixed N of the controls."""
+    return {kind: Vanilla(int(p["n"]), SafeStep(kind, _error(p))) for kind in ("scalar", "coordinate")}
 
 
 def steps_result(p: Mapping[str, Any], traces: Mapping[str, Any], data: Mapping[str, Any]) -> dict[str, Any]:
@@ -144,19 +153,21 @@ def lqg2d_steps_explorer() -> Ch5LiveExplorer:
 
     def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:
         traces = {}
-        for k, (step, kw) in enumerate(steps_configs(p).items()):
-            rec = vanilla_pg(env, np.asarray(cfg.theta0, float), float(p["sigma"]),
-                             rng=np.random.default_rng([_seed(p), k]),
-                             progress=_reporter(progress, k, 2, int(p["budget"]), STEP_LABELS[step]), **kw)
+        for k, (step, method) in enumerate(steps_configs(p).items()):
+            rec = learn(env, method, np.asarray(cfg.theta0, float), float(p["sigma"]), budget=int(p["budget"]),
+                        rng=np.random.default_rng([_seed(p), k]),
+                        progress=_reporter(progress, k, 2, int(p["budget"]), STEP_LABELS[step]))
             traces[step] = record_trace(rec)
         out = steps_result(p, traces, data)
         return kernel_text(out)
 
-    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, cfg.delta),
+    method = cfg.method
+    assert isinstance(method, Vanilla) and isinstance(method.step, SafeStep)
+    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, method.step.error.delta),
                 Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
-                Select("bound", "bound", BOUND_CHOICES, cfg.bound),
+                Select("bound", "bound", BOUND_CHOICES, method.step.error.bound),
                 Select("n", "N", tuple((str(n), f"{n:,}") for n in (100, 500, 1000, 2000, 5000, 10_000)),
-                       str(cfg.batch_size)),
+                       str(method.batch_size)),
                 Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
                 Slider("seed", "seed", 0, 99, 1, 0)]
     plots = [Plot("theta", "updates", "gain theta_11, theta_22"), Plot("J", "updates", "expected performance J")]
@@ -168,19 +179,17 @@ def lqg2d_steps_explorer() -> Ch5LiveExplorer:
 
 
 # ---------------------------------------------------------------- Figures 5.7-5.8
-def adaptive_configs(p: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """The safepg keyword arguments of each run of the adaptive explorer (the page's ``configs``):
-    with ``authors`` on, Algorithm 4.1 takes the authors' statistics, unguarded step and first batch
-    (their N_max is the N_max control's 100000, which ticking the switch selects)."""
-    bound, er = _bound(p)
-    common = dict(bound=bound, empirical_range=er, delta=float(p["delta"]), budget=int(p["budget"]))
-    adaptive = dict(n_min=100, n_max=int(p["n_max"]), **common)
-    if p["authors"]:
-        adaptive.update(statistics=AUTHORS_2D["statistics"], step_when_unsafe=AUTHORS_2D["step_when_unsafe"],
-                        n_first=AUTHORS_2D["n_first"])
-    runs = {"adaptive": adaptive}
+def adaptive_configs(p: Mapping[str, Any]) -> dict[str, Method]:
+    """The method of each run of the adaptive explorer (the page's ``configs``): with ``authors``
+    on, Algorithm 4.1 takes the authors' departures and first batch (their N_max is the N_max
+    control's 100000, which ticking the switch selects)."""
+    authors = authors_2d()
+    batches = Batches(100, int(p["n_max"]), authors.batches.first if p["authors"] else None)
+    adaptive = Adaptive(error=_error(p), batches=batches,
+                        departures=authors.departures if p["authors"] else Departures())
+    runs: dict[str, Method] = {"adaptive": adaptive}
     for name, n, _ in FIXED_RUNS:
-        runs[name] = dict(batch_size=n, alpha=1e-6, step="scalar", stop_on_divergence=True, **common)
+        runs[name] = Vanilla(n, FixedStep(1e-6))
     return runs
 
 
@@ -224,8 +233,8 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     t = exp.thesis
     data = {"task": _task_or_none(env), "theta0": list(cfg.theta0), "points": CURVE_POINTS,
             "runs": [["adaptive", ADAPTIVE_COLOR], *[[n, c] for n, _, c in FIXED_RUNS]],
-            "authors": {"statistics": "max", "stepWhenUnsafe": True, "nFirst": AUTHORS_2D["n_first"],
-                        "nMax": AUTHORS_2D["n_max"]},
+            "authors": {k: v for k, v in learner_options(authors_2d()).items()
+                        if k in ("statistics", "stepWhenUnsafe", "nFirst", "nMax")},
             "printed": (f"Table 5.3 prints after 3*10^7 trajectories: Upsilon-bar {t['adaptive']['upsilon_bar']} "
                         f"(adaptive), {t['N=1000']['upsilon_bar']} (N = 1000), {t['N=100']['upsilon_bar']} "
                         "(N = 100).")}
@@ -233,25 +242,22 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:
         traces = {}
         budget = int(p["budget"])
-        for k, (name, kw) in enumerate(adaptive_configs(p).items()):
-            kw = {**kw, "rng": np.random.default_rng([_seed(p), k]),
-                  "progress": _reporter(progress, k, 3, budget, name)}
-            theta0 = np.asarray(cfg.theta0, float)
-            if name == "adaptive":
-                rec = adaptive_pg(env, theta0, float(p["sigma"]), **kw)
-                traces[name] = record_trace(rec, record_c(rec))
-            else:
-                traces[name] = record_trace(vanilla_pg(env, theta0, float(p["sigma"]), **kw))
+        for k, (name, method) in enumerate(adaptive_configs(p).items()):
+            rec = learn(env, method, np.asarray(cfg.theta0, float), float(p["sigma"]), budget=budget,
+                        rng=np.random.default_rng([_seed(p), k]), progress=_reporter(progress, k, 3, budget, name))
+            traces[name] = record_trace(rec, record_c(rec)) if name == "adaptive" else record_trace(rec)
         out = adaptive_result(p, traces, data)
         return kernel_text(out)
 
-    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, cfg.delta),
+    method = cfg.method
+    assert isinstance(method, Adaptive)
+    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, method.error.delta),
                 Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
                 Select("bound", "bound", BOUND_CHOICES, "bernstein-er"),
                 Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
                 Slider("seed", "seed", 0, 99, 1, 0),
                 Select("n_max", "N_max", tuple((str(n), f"{n:,}") for n in (10_000, 100_000, 500_000)),
-                       str(cfg.n_max)),
+                       str(method.batches.n_max)),
                 Checkbox("authors", "the authors' adaptive settings (max statistics, unguarded step, "
                                     "first N 100, N_max 100,000)", False)]
     plots = [Plot("J", "trajectories", "expected performance J"),
@@ -263,5 +269,5 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     return ex
 
 
-__all__ = ["AUTHORS_2D", "BUDGETS", "adaptive_configs", "adaptive_result", "lqg2d_adaptive_explorer", "lqg2d_env",
+__all__ = ["BUDGETS", "adaptive_configs", "authors_2d", "adaptive_result", "lqg2d_adaptive_explorer", "lqg2d_env",
            "lqg2d_steps_explorer", "steps_configs", "steps_result"]

@@ -63,7 +63,6 @@ from safepg.thesis.scorecard.rows import (
     NEEDED,
     RANGE_VARIANTS,
     RUN_PAGES,
-    THETA0_VARIANTS,
     scorecard,
 )
 from safepg.thesis.scorecard.rules import (
@@ -97,7 +96,7 @@ from safepg.thesis.scorecard.rules import (
 __all__ = [
     "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "CURVE_SHARE", "FROZEN_THETA",
     "GROUPS", "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS",
-    "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "THETA0_VARIANTS",
+    "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
     "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "counts_text", "group_html", "half_unit",
     "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
     "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",

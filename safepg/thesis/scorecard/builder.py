@@ -190,21 +190,14 @@ class Builder:
     book: Path = BOOK
     rows: list[Row] = field(default_factory=list)
 
-    def add(self, spec: RowSpec | None = None, /, **legacy: Any) -> None:
+    def add(self, spec: RowSpec) -> None:
         """Append the row ``spec`` describes, judged.
-
-        ``legacy``: the former keywords (``authors_ok=...``, ``seeds=...``), for the callers not yet
-        written with :class:`RowSpec` (:func:`spec_from_keywords`); not with ``spec``.
 
         Raises
         ------
         MissingValueError
             If the row's note is filled and quotes values the row does not give.
         """
-        if spec is None:
-            spec = spec_from_keywords(**legacy)
-        elif legacy:
-            raise TypeError(f"give a RowSpec or keywords, not both: {sorted(legacy)}")
         ok, explanation = spec.ok, spec.explanation
         if partly_computed(spec):
             ok, explanation = None, (f"Not judged: only {spec.seeds} of {spec.expected_seeds} seeds are in the "
@@ -236,22 +229,3 @@ class Builder:
             return book_link(note.page, note.heading, self.book)
         return book_link(spec.page, spec.heading, self.book)
 
-
-#: The former keywords of ``Builder.add`` that name a field of :class:`AuthorsColumn` or :class:`Output`.
-_AUTHORS_KEYWORDS = {"authors": "text", "authors_experiment": "experiment", "authors_value": "value",
-                     "authors_ci95": "ci95", "authors_seeds": "seeds", "authors_ok": "ok",
-                     "authors_interval": "interval", "authors_interval_text": "interval_text",
-                     "authors_vacuous": "vacuous", "authors_note": "note", "authors_error": "error"}
-_OUTPUT_KEYWORDS = {"authors_output": "text", "authors_output_value": "value", "authors_output_source": "source"}
-
-
-def spec_from_keywords(**keywords: Any) -> RowSpec:
-    """A :class:`RowSpec` from the former flat keywords of ``Builder.add`` (``authors_ok``, ...).
-
-    Kept while tests/test_verdicts.py builds its synthetic rows that way; every keyword still names a
-    declared field (an unknown one raises TypeError, as does a missing required one).
-    """
-    authors = {_AUTHORS_KEYWORDS[k]: keywords.pop(k) for k in list(keywords) if k in _AUTHORS_KEYWORDS}
-    output = {_OUTPUT_KEYWORDS[k]: keywords.pop(k) for k in list(keywords) if k in _OUTPUT_KEYWORDS}
-    return RowSpec(**keywords, authors=AuthorsColumn(**authors),
-                   output=Output(**{"value": None, "text": "", "source": "", **output}) if output else None)

@@ -6,14 +6,9 @@ from collections.abc import Collection, Mapping
 from pathlib import Path
 
 from safepg.learning import LearningRecord
-from safepg.thesis.experiments import (
-    EXPERIMENTS,
-    Experiment,
-    get_experiment,
-    load_experiment,
-    report,
-    run_experiment,
-)
+from safepg.thesis.experiment_store import load_experiment, run_experiment
+from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment
+from safepg.thesis.report import report
 from safepg.thesis.scorecard.builder import Builder
 from safepg.thesis.scorecard.closed_forms import closed_form_rows
 from safepg.thesis.scorecard.curves import curve_rows
@@ -28,8 +23,6 @@ NEEDED = ("table-5.1", "table-5.1-printed-theta0", "table-5.2", "figures-5.5-5.6
 #: The variant of Table 5.2 with Lemma 4.3.3's range (the text's), when the library defines it
 #: (``table-5.2`` runs the authors' range).
 RANGE_VARIANTS = ("table-5.2-lemma-range",)
-#: Kept for callers of older versions: Table 5.1 from the printed theta_0 is now in :data:`NEEDED`.
-THETA0_VARIANTS: tuple[str, ...] = ()
 #: Ours under the authors' settings (their code's where the text says otherwise or nothing). Read
 #: from the store, never computed here (``python -m safepg run NAME`` computes them): rows whose
 #: runs are missing or partly stored show them without judging them.

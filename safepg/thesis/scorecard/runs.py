@@ -14,6 +14,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from safepg.learning import LearningRecord
+from safepg.options import Adaptive, FixedStep, Vanilla
+from safepg.runner import RunConfig
 from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
 from safepg.thesis.scorecard import outputs
@@ -46,6 +48,20 @@ from safepg.thesis.scorecard.rules import (
     within_points,
 )
 from safepg.thesis.scorecard.text import ci_text, num, pct, signed
+
+
+def _cell(c: RunConfig) -> tuple[float, int, float]:
+    """(sigma, N, alpha) of a Table 5.1 run (fixed batch size and step)."""
+    m = c.method
+    assert isinstance(m, Vanilla) and isinstance(m.step, FixedStep)
+    return c.sigma, m.batch_size, m.step.alpha
+
+
+def _row_key(c: RunConfig) -> tuple[str, str, bool, float]:
+    """(estimator, bound, empirical range, delta) of a Table 5.2 run, the key of its row everywhere."""
+    m = c.method
+    assert isinstance(m, Adaptive)
+    return m.gradient.estimator, m.error.bound, m.error.empirical_range, m.error.delta
 
 
 def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
@@ -99,15 +115,14 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
     """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the
     authors' settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed
     theta_0, found before their outputs were read) is quoted in the explanation."""
-    recon = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(exp.configs, rep["configs"])}
-    theirs = {(c.sigma, c.batch_size, c.alpha): r for c, r in zip(authors.configs if authors else (),
-                                                                   (authors_rep or {}).get("configs", []))}
+    recon = {_cell(c): r for c, r in zip(exp.configs, rep["configs"])}
+    theirs = {_cell(c): r for c, r in zip(authors.configs if authors else (), (authors_rep or {}).get("configs", []))}
     starts = Theta0s(printed_theta0=f"{T51_PRINTED_THETA0:g}", authors_theta0=f"{AUTHORS_T51_THETA0:g}")
     for c, r in zip(printed.configs, printed_rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
         if thesis is None:
             continue
-        key = (c.sigma, c.batch_size, c.alpha)
+        key = sigma, n, alpha = _cell(c)
         mean, ci = _mean_ci(r["improvement_ratio"])
         ok = None if mean is None else one_run_ratio(thesis, r)
         ar = theirs.get(key)
@@ -124,8 +139,8 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
              f"gives {pct(rc_mean)}.")
         out = outputs.table_5_1(*key)
         printed_text = f"{100 * thesis:.6g}"
-        b.add(RowSpec(id=f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}", group="Section 5.1",
-              quantity=f"improvement ratio, σ = {c.sigma:g}, N = {c.batch_size}, α = {c.alpha:.0e}", where="Table 5.1",
+        b.add(RowSpec(id=f"table-5.1/sigma={sigma:g}/N={n}/alpha={alpha:.0e}", group="Section 5.1",
+              quantity=f"improvement ratio, σ = {sigma:g}, N = {n}, α = {alpha:.0e}", where="Table 5.1",
               thesis=pct(thesis),
               ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
               difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
@@ -137,7 +152,7 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
                               "(where all 24 of their output files start), counted as they counted (strict increases "
                               "over 10^6/N - 1 updates), it is inside." + recon_text),
               slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
-              fields={"sigma": c.sigma, "N": c.batch_size, "alpha": c.alpha, "theta0": c.theta0[0]},
+              fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]},
               output=out, note_values=starts))
 
 
@@ -153,14 +168,14 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
     fmt = lambda x: num(x, dec)  # noqa: E731
     lemma = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
-        if vc.theoretical_range is None:
-            lemma[(vc.estimator, vc.bound, vc.empirical_range, vc.delta)] = (vc, vr)
+        if vc.method.error.theoretical_range is None:
+            lemma[_row_key(vc)] = (vc, vr)
     ratios, still = [], []
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
         if "upsilon_bar" not in th:
             continue
-        key = (c.estimator, c.bound, c.empirical_range, c.delta)
+        key = estimator, bound, empirical_range, delta = _row_key(c)
         mean, ci = _mean_ci(r["upsilon_bar"])
         if frozen(r.get("theta_moved")):  # its ratio, whatever it is, says nothing
             still.append(c.name)
@@ -168,7 +183,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             ratios.append(r["improvement_ratio"]["mean"])
         out = outputs.table_5_2(key)
         seeds, a_col, note_id, guarded, range_runs = r["seeds"], AuthorsColumn(), None, "", None
-        theoretical = c.bound != "chebyshev" and not c.empirical_range and key in lemma
+        theoretical = bound != "chebyshev" and not empirical_range and key in lemma
         if theoretical:
             vc, vr = lemma[key]
             guarded = f"{fmt(mean)}{ci_text(ci, fmt)}"  # the authors' range, our guarded step (table-5.2)
@@ -190,11 +205,11 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                                    f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
         ok = None if mean is None else intervals_overlap(ci, th["ci95"])
-        er = " (e.r.)" if c.empirical_range else ""
-        label = f"{c.estimator}-{c.bound}{'-er' if c.empirical_range else ''}-delta={c.delta:g}"
+        er = " (e.r.)" if empirical_range else ""
+        label = f"{estimator}-{bound}{'-er' if empirical_range else ''}-delta={delta:g}"
         b.add(RowSpec(id=f"table-5.2/{label}", group="Section 5.1",
-              quantity=f"average performance, {'REINFORCE' if c.estimator == 'reinforce' else 'G(PO)MDP'}, "
-              f"{c.bound.capitalize()}{er}, δ = {c.delta:g}", where="Table 5.2",
+              quantity=f"average performance, {'REINFORCE' if estimator == 'reinforce' else 'G(PO)MDP'}, "
+              f"{bound.capitalize()}{er}, δ = {delta:g}", where="Table 5.2",
               thesis=f"{fmt(th['upsilon_bar'])}{ci_text(th['ci95'], fmt)}", ours=f"{fmt(mean)}{ci_text(ci, fmt)}",
               difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
               kind="mean of runs", page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"],
@@ -207,8 +222,8 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
                   f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
               slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
-              fields={"estimator": c.estimator, "bound": c.bound, "empirical_range": c.empirical_range,
-                      "delta": c.delta, "theoretical_range": None if theoretical else c.theoretical_range,
+              fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range,
+                      "delta": delta, "theoretical_range": None if theoretical else c.method.error.theoretical_range,
                       "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
     complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
@@ -237,15 +252,15 @@ def _median_steps(recs: Mapping[str, Sequence], names: list[str], seeds: int) ->
 
 
 def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, recs: Mapping[str, Sequence],
-               names: Iterable[str], k: int, page: str, heading: str, seeds: int, authors: Experiment | None = None,
-               authors_recs: Mapping[str, Sequence] | None = None, output: outputs.Output | None = None,
-               authors_note: str = "") -> None:
+               names: Iterable[str], exponent: int, page: str, heading: str, seeds: int,
+               authors: Experiment | None = None, authors_recs: Mapping[str, Sequence] | None = None,
+               output: outputs.Output | None = None, authors_note: str = "") -> None:
     names = list(names)
     medians = _median_steps(recs, names, seeds)
     if medians:  # "in all the experiments": every configuration run
         ours = f"median {np.median(medians):.1e}" + \
                (f" (per configuration {min(medians):.1e} to {max(medians):.1e})" if len(medians) > 1 else "")
-        ok = all(order_of_magnitude(m) == k for m in medians)
+        ok = all(order_of_magnitude(m) == exponent for m in medians)
         value = float(np.median(medians))
         diff = f"order 10^{order_of_magnitude(value)}"
     else:
@@ -258,10 +273,11 @@ def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, r
         n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
         a_col = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
                          f"median {np.median(a_med):.1e}" if a_med else "-",
-                         lambda *_: all(order_of_magnitude(m) == k for m in a_med))  # type: ignore[union-attr]
-    b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{k}", ours=ours,
+                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))  # type: ignore[union-attr]
+    b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{exponent}",
+          ours=ours,
           difference=diff, ok=ok, rule="order", kind="read off a figure", page=page, heading=heading,
-          thesis_value=10.0**k, ours_value=value, interval_text="reading precision: an order of magnitude",
+          thesis_value=10.0**exponent, ours_value=value, interval_text="reading precision: an order of magnitude",
           authors=replace(a_col, note=authors_note), output=output))
 
 
@@ -274,7 +290,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             mean, ci = _mean_ci(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
             b.add(RowSpec(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", output=out,
-                  quantity=f"improvement ratio, {label}, N = {c.batch_size}", where="Section 5.2.1 (Figure 5.5)",
+                  quantity=f"improvement ratio, {label}, N = {c.method.batch_size}", where="Section 5.2.1 (Figure 5.5)",
                   thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
@@ -324,7 +340,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
     fmt = lambda x: num(x, dec)  # noqa: E731
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
-        method = "adaptive N" if c.batch_size is None else f"N = {c.batch_size}"
+        method = f"N = {c.method.batch_size}" if isinstance(c.method, Vanilla) else "adaptive N"
         ar = _report_row(authors_rep, c.name)
         other = _report_row(also[1], c.name) if also else None
         if "upsilon_bar" in th:
@@ -448,7 +464,7 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
               slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
-               k=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
+               exponent=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
                authors_recs=authors_recs, output=outputs.lqg2d("adaptive", "step"), authors_note=note)
 
 
@@ -479,9 +495,11 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
                          "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
                          lambda *_, i=a_pi, t=text: in_prediction(t, i), interval=a_pi,
                          interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
+        search = c.method
+        assert isinstance(search, Vanilla) and isinstance(search.step, FixedStep) and search.target is not None
         b.add(RowSpec(id="section-5.3/baseline-iterations", group="Section 5.3",
-              quantity=f"iterations of the baseline (N = {c.batch_size}, α = {c.alpha:g}) to reach "
-              f"{c.target_return:g}", where="Section 5.3", thesis=text,
+              quantity=f"iterations of the baseline (N = {search.batch_size}, α = {search.step.alpha:g}) to reach "
+              f"{search.target.value:g}", where="Section 5.3", thesis=text,
               ours="-" if mean is None else f"{mean:.1f} (seeds {min(its):.0f} to {max(its):.0f})",
               difference="-" if mean is None else f"{mean - th['iterations']:+.1f}",
               ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
@@ -564,7 +582,7 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
                     reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
-               names=[c.name for c in exps["table-5.2"].configs], k=PRINTED["lqg1d_step_order"], page="lqg1d",
+               names=[c.name for c in exps["table-5.2"].configs], exponent=PRINTED["lqg1d_step_order"], page="lqg1d",
                heading="Figures 5.3 and 5.4", seeds=exps["table-5.2"].seeds)
     _figures_5_5_5_6_rows(b, exps["figures-5.5-5.6"], reps["figures-5.5-5.6"], recs["figures-5.5-5.6"])
     _upsilon_table_rows(b, "table-5.3", exps["table-5.3"], reps["table-5.3"], "lqg2d", "Table 5.3", "Section 5.2",

@@ -22,9 +22,8 @@ const safepgCartpolePage = {
                     seed: Math.round(p.seed)};
     const adaptive = {...common, algorithm: "adaptive", nMin: 100, nMax: 500000, nFirst: null, constants: "bounds",
                       statistics: "component", stepWhenUnsafe: false, stream: 0};
-    const rename = {n_min: "nMin", n_first: "nFirst", step_when_unsafe: "stepWhenUnsafe"};
-    for (const [box, opts] of Object.entries(data.settings))
-      if (p[box]) for (const [k, v] of Object.entries(opts)) adaptive[rename[k] || k] = v;
+    // Each ticked box's options, already under the learner's names (js_tasks.learner_options).
+    for (const [box, opts] of Object.entries(data.settings)) if (p[box]) Object.assign(adaptive, opts);
     const vanilla = {...common, algorithm: "vanilla", ...data.vanilla, stopOnDivergence: true, stream: 1};
     return {task: task, runs: [{name: "adaptive", cfg: adaptive}, {name: "vanilla", cfg: vanilla}]};
   },

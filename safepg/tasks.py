@@ -1,0 +1,162 @@
+"""What a task offers the learning loops: the required interface and the optional fast paths.
+
+A task must simulate batches and state the bounds of Assumption 4.2.1 (:class:`Task`). It
+may also offer fast paths, each a Protocol of one method that the task's class declares by
+inheriting it:
+
+* :class:`GradientBatch`: a batch's gradient samples and returns in one fused call;
+* :class:`GradientBatchMaxima`: the same and the batch's measured R and M_phi;
+* :class:`MeasuredReturns`: the per-trajectory performance the loops record as J_hat;
+* :class:`Performance` / :class:`PerformanceBatch`: the closed-form J;
+* :class:`ActionDimension`: the number of action dimensions (else 1).
+
+:func:`task_hooks` checks a task once, when a learning loop starts: a declared hook that is
+missing or has other parameters, or a method with a hook's name that is not declared, is a
+``TypeError`` (a misspelt hook would otherwise be skipped in silence).
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from safepg.constants import BoundedTask
+from safepg.policies import LinearGaussianPolicy
+from safepg.rng import RNGLike
+from safepg.trajectories import Trajectories
+
+
+class Task(BoundedTask, Protocol):
+    """The required interface: ``simulate`` and the bounds (``reward_bound``, ``feature_bound``,
+    ``action_volume``, ``action_bound``, ``gamma``, ``horizon``)."""
+
+    def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
+        """``n`` trajectories of ``policy``."""
+        ...
+
+
+class ActionDimension(Protocol):
+    """A task whose actions have ``action_dim`` components (the gain has that many rows)."""
+
+    action_dim: int
+
+
+class GradientBatch(Protocol):
+    """Gradient samples (n, m) and measured returns (n,) of a fresh batch in one call."""
+
+    def gradient_batch(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None, estimator: str = "gpomdp",
+                       baseline: bool = True, score_action: str = "clipped") -> tuple[np.ndarray, np.ndarray]:
+        """The same numbers as ``gradient_samples`` on ``simulate``'s batch."""
+        ...
+
+
+class GradientBatchMaxima(Protocol):
+    """:class:`GradientBatch` plus the batch's measured (R, M_phi): its largest |reward| and |feature|."""
+
+    def gradient_batch_maxima(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None,
+                              estimator: str = "gpomdp", baseline: bool = True, score_action: str = "clipped",
+                              ) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """Samples, returns and (R, M_phi) of one batch."""
+        ...
+
+
+class MeasuredReturns(Protocol):
+    """The per-trajectory performance recorded as J_hat (default: the discounted return)."""
+
+    def measured_returns(self, batch: Trajectories) -> np.ndarray:
+        """Shape (N,)."""
+        ...
+
+
+class Performance(Protocol):
+    """The closed-form J of one parameter."""
+
+    def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
+        """J(theta)."""
+        ...
+
+
+class PerformanceBatch(Protocol):
+    """The closed-form J of many parameters at once."""
+
+    def performance_batch(self, thetas: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
+        """J of each row of ``thetas``."""
+        ...
+
+
+#: The optional methods, by the Protocol that declares each.
+METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchMaxima: "gradient_batch_maxima",
+                                 MeasuredReturns: "measured_returns", Performance: "performance",
+                                 PerformanceBatch: "performance_batch"}
+
+
+@dataclass(frozen=True)
+class Hooks:
+    """A task's fast paths, bound to the task (None where it has none)."""
+
+    gradient_batch: Callable[..., tuple[np.ndarray, np.ndarray]] | None
+    gradient_batch_maxima: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
+    measured_returns: Callable[[Trajectories], np.ndarray] | None
+    performance: Callable[[Any, Any], float] | None
+    performance_batch: Callable[[np.ndarray, Any], np.ndarray] | None
+    action_dim: int
+
+
+def _parameters(func: Callable[..., Any]) -> list[tuple[str, bool]]:
+    """(name, has a default) of each parameter after ``self``."""
+    params = list(inspect.signature(func).parameters.values())
+    if params and params[0].name == "self":
+        params = params[1:]
+    return [(p.name, p.default is not inspect.Parameter.empty) for p in params
+            if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+
+
+def _check_signature(cls: type, proto: type, name: str) -> None:
+    expected = _parameters(getattr(proto, name))
+    got = _parameters(getattr(cls, name))
+    names = [n for n, _ in got]
+    # The loops call hooks positionally: the Protocol's parameters first, any further ones optional.
+    if names[:len(expected)] != [n for n, _ in expected] or not all(d for _, d in got[len(expected):]):
+        raise TypeError(f"{cls.__name__}.{name} must take ({', '.join(n for n, _ in expected)}) as "
+                        f"{proto.__name__} declares, got ({', '.join(names)})")
+
+
+def task_hooks(task: Task) -> Hooks:
+    """Check ``task``'s declared fast paths and return them bound.
+
+    Raises
+    ------
+    TypeError
+        A declared hook is missing or takes other parameters than its Protocol, or the task
+        has a method named like a hook without declaring its Protocol.
+    """
+    cls = type(task)
+    for attr in ("simulate", "reward_bound", "feature_bound", "action_volume", "action_bound", "gamma", "horizon"):
+        if not hasattr(task, attr):
+            raise TypeError(f"task must have {attr!r} (safepg.tasks.Task), {cls.__name__} has not")
+    found: dict[str, Any] = {}
+    for proto, name in METHOD_HOOKS.items():
+        declared = proto in cls.__mro__
+        method = getattr(cls, name, None)
+        if declared and (method is None or method is getattr(proto, name)):
+            raise TypeError(f"{cls.__name__} declares {proto.__name__} but does not define {name}")
+        if not declared and method is not None:
+            raise TypeError(f"{cls.__name__} defines {name} but does not declare safepg.tasks.{proto.__name__}: "
+                            f"inherit it so the learning loops use it")
+        if declared:
+            _check_signature(cls, proto, name)
+            found[name] = getattr(task, name)
+    action_dim = 1
+    if ActionDimension in cls.__mro__:
+        action_dim = task.action_dim  # type: ignore[attr-defined]
+        if isinstance(action_dim, bool) or not isinstance(action_dim, int | np.integer) or action_dim < 1:
+            raise TypeError(f"{cls.__name__}.action_dim must be an integer >= 1, got {action_dim!r}")
+    return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
+
+
+__all__ = ["ActionDimension", "GradientBatch", "GradientBatchMaxima", "Hooks", "MeasuredReturns", "Performance",
+           "PerformanceBatch", "Task", "task_hooks"]
