@@ -17,7 +17,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from safepg.thesis.experiments import EXPERIMENTS, report, run_experiment
+from safepg.thesis.experiment_store import run_experiment
+from safepg.thesis.experiments import EXPERIMENTS
+from safepg.thesis.report import report
 
 TIMINGS = Path(__file__).with_name("campaign_timings.json")
 

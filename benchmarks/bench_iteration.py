@@ -40,7 +40,7 @@ def one_iteration(env: LQG, policy: LinearGaussianPolicy, n: int, rng: np.random
         gradient_samples(policy, env.simulate(policy, n, rng), "gpomdp", True)
     grad = samples.mean(axis=0)
     k = int(np.argmax(np.abs(grad)))
-    eb = error_bound("bernstein", samples[:, k], 0.95, consts, "gpomdp", True)
+    eb = error_bound("bernstein", samples[:, k], 0.95, consts, "gpomdp", "empirical")
     coordinate_step(abs(grad[k]), eb.eps(n), c)
     return optimal_batch_size(abs(grad[k]), eb, c, 100, 500_000)
 
@@ -61,8 +61,9 @@ def best_time(fn, repeat: int) -> float:
 
 
 VANILLA_2D = ("from safepg.envs.lqg import LQG; from safepg.learning import vanilla_pg; "
+              "from safepg.options import FixedStep; "
               "import numpy as np, numba; numba.set_num_threads(1); "
-              "vanilla_pg(LQG.thesis_2d(gamma=0.9), np.zeros(4), 1.0, batch_size=100, alpha=1e-6, "
+              "vanilla_pg(LQG.thesis_2d(gamma=0.9), np.zeros(4), 1.0, batch_size=100, step=FixedStep(1e-6), "
               "budget=1_000_000, rng=0)")
 
 

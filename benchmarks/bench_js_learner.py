@@ -161,6 +161,7 @@ def main() -> None:
 
     from safepg import LQG, adaptive_pg
     from safepg.envs.cartpole import CartPole
+    from safepg.options import ErrorModel
     from safepg.policies import LinearGaussianPolicy
     from safepg.thesis.authors import cartpole_theta_star
     from safepg.thesis.experiments import AUTHORS_DOUBLED, make_env
@@ -185,14 +186,14 @@ def main() -> None:
     # Trajectory-steps of each measurement, for the per-step figures.
     steps = {"batch_1e5_gpomdp": 2e6, "batch_1e5_reinforce": 2e6, "run_1e6": 2e7, "lqg2d_fig57_tenth": 6e7,
              "cartpole_1e5": 1e5 * js["cartpole_1e5"]["mean_steps"]}
-    py["run_1e6"] = best_of(lambda: adaptive_pg(env, 0.0, 1.0, bound="bernstein", empirical_range=True,
-                                                budget=1_000_000, rng=next(seeds)), args.repeat)
+    bernstein_er = ErrorModel("bernstein", range="empirical")
+    py["run_1e6"] = best_of(lambda: adaptive_pg(env, 0.0, 1.0, error=bernstein_er, budget=1_000_000,
+                                                rng=next(seeds)), args.repeat)
     star_policy = LinearGaussianPolicy(star.reshape(1, 4), 1.0)
     py["cartpole_1e5"] = best_of(lambda: [cartpole.gradient_batch(star_policy, 1000, rng) for _ in range(100)],
                                  args.repeat)
-    py["lqg2d_fig57_tenth"] = best_of(lambda: adaptive_pg(lqg2d, np.zeros(4), 1.0, bound="bernstein",
-                                                          empirical_range=True, budget=3_000_000, rng=next(seeds)),
-                                      args.repeat)
+    py["lqg2d_fig57_tenth"] = best_of(lambda: adaptive_pg(lqg2d, np.zeros(4), 1.0, error=bernstein_er,
+                                                          budget=3_000_000, rng=next(seeds)), args.repeat)
     browser = None if args.no_browser else chromium_runs(args.repeat)
     result = {
         "what": "best of --repeat calls; batch: N = 1e5 trajectories, H = 20, random numbers included; run: "

@@ -16,6 +16,7 @@ import numpy as np
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.options import ErrorModel, FixedStep, Gradient, SafeStep
 from safepg.stats import mean_ci95
 
 
@@ -30,21 +31,21 @@ def digest(rec: LearningRecord) -> dict[str, object]:
 
 def runs() -> dict[str, list[LearningRecord]]:
     lqg1, lqg2 = LQG.thesis_1d(), LQG.thesis_2d(gamma=0.9)
+    bernstein_er = ErrorModel("bernstein", range="empirical")
     return {
-        "1d-bernstein-er": [adaptive_pg(lqg1, bound="bernstein", empirical_range=True, budget=60_000, rng=s)
-                            for s in range(3)],
-        "1d-chebyshev-reinforce": [adaptive_pg(lqg1, estimator="reinforce", budget=60_000, rng=s) for s in range(3)],
-        "1d-hoeffding": [adaptive_pg(lqg1, bound="hoeffding", budget=30_000, rng=0)],
-        "1d-vanilla-raw": [vanilla_pg(lqg1, -0.55, 0.5, batch_size=100, alpha=1e-3, score_action="raw",
+        "1d-bernstein-er": [adaptive_pg(lqg1, error=bernstein_er, budget=60_000, rng=s) for s in range(3)],
+        "1d-chebyshev-reinforce": [adaptive_pg(lqg1, gradient=Gradient("reinforce"), budget=60_000, rng=s)
+                                   for s in range(3)],
+        "1d-hoeffding": [adaptive_pg(lqg1, error=ErrorModel("hoeffding"), budget=30_000, rng=0)],
+        "1d-vanilla-raw": [vanilla_pg(lqg1, -0.55, 0.5, batch_size=100, step=FixedStep(1e-3),
+                                      gradient=Gradient(score_action="raw"), budget=20_000, rng=0)],
+        "2d-scalar-step": [vanilla_pg(lqg2, np.zeros(4), batch_size=500, step=SafeStep("scalar"),
                                       budget=20_000, rng=0)],
-        "2d-scalar-step": [vanilla_pg(lqg2, np.zeros(4), batch_size=500, alpha=None, step="scalar",
-                                      budget=20_000, rng=0)],
-        "2d-bernstein": [adaptive_pg(lqg2, np.zeros(4), bound="bernstein", empirical_range=True,
-                                     budget=30_000, rng=0)],
-        "cartpole-vanilla": [vanilla_pg(CartPole.thesis(), np.zeros(4), batch_size=200, alpha=0.01,
+        "2d-bernstein": [adaptive_pg(lqg2, np.zeros(4), error=bernstein_er, budget=30_000, rng=0)],
+        "cartpole-vanilla": [vanilla_pg(CartPole.thesis(), np.zeros(4), batch_size=200, step=FixedStep(0.01),
                                         budget=2_000, rng=0)],
         "cartpole-adaptive": [adaptive_pg(CartPole.thesis_doubled(), np.array([0.5, 1.0, 20.0, 3.0]),
-                                          bound="bernstein", empirical_range=True, budget=2_000, rng=0)],
+                                          error=bernstein_er, budget=2_000, rng=0)],
     }
 
 

@@ -5,6 +5,7 @@ import pytest
 
 from safepg.envs.lqg import LQG
 from safepg.learning import vanilla_pg
+from safepg.options import ErrorModel, FixedStep
 from safepg.thesis import audit, safety
 from safepg.thesis import experiments as ex
 
@@ -34,7 +35,7 @@ def test_unknown_section_is_refused():
 
 
 def test_closed_form_outcomes_count_what_the_record_shows():
-    rec = vanilla_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, batch_size=100, alpha=1e-3, budget=5000, rng=1)
+    rec = vanilla_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, batch_size=100, step=FixedStep(1e-3), budget=5000, rng=1)
     out = safety.closed_form_outcomes(rec)
     dJ = np.diff(rec.J)
     moved = np.diff(rec.theta[:, 0]) != 0
@@ -58,7 +59,8 @@ def test_closed_form_table_of_a_small_adaptive_lqg_run():
     """An adaptive run on the 1-D LQG: its steps that did not move theta are no updates."""
     from safepg import adaptive_pg
 
-    rec = adaptive_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, bound="chebyshev", delta=0.95, budget=60_000, rng=2)
+    rec = adaptive_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, error=ErrorModel("chebyshev", 0.95), budget=60_000,
+                      rng=2)
     out = safety.closed_form_outcomes(rec)
     moved = np.diff(rec.theta[:, 0]) != 0
     assert out["updates"] == moved.sum() > 0

@@ -65,11 +65,11 @@ def test_bound_d_and_f():
 def test_error_bound_selects_the_right_ingredients():
     rng = np.random.default_rng(0)
     x = rng.normal(size=1000)
-    er = error_bound("hoeffding", x, 0.2, K1, empirical_range=True)
+    er = error_bound("hoeffding", x, 0.2, K1, range="empirical")
     assert er.d == pytest.approx(np.ptp(x) * math.sqrt(math.log(10) / 2))
     th = error_bound("hoeffding", x, 0.2, K1)
     assert th.d == pytest.approx(gradient_range_bound(K1) * math.sqrt(math.log(10) / 2))
-    be = error_bound("bernstein", x, 0.2, K1, empirical_range=True)
+    be = error_bound("bernstein", x, 0.2, K1, range="empirical")
     assert be.d == pytest.approx(math.sqrt(2 * np.var(x, ddof=1) * math.log(15)))
     assert error_bound("chebyshev", x, 0.2, K1, "reinforce").d > error_bound("chebyshev", x, 0.2, K1).d
 
@@ -181,7 +181,9 @@ def test_bad_constants_raise():
 
 def test_theoretical_range_override():
     x = np.arange(10.0)
-    assert error_bound("hoeffding", x, 0.5, K1, theoretical_range=1280.0).d == pytest.approx(
+    assert error_bound("hoeffding", x, 0.5, K1, range=1280.0).d == pytest.approx(
         1280.0 * math.sqrt(math.log(4) / 2))
-    with pytest.raises(ValueError, match="^theoretical_range"):
-        error_bound("hoeffding", x, 0.5, K1, theoretical_range=-1.0)
+    assert error_bound("hoeffding", x, 0.5, K1, range="lemma").d == error_bound("hoeffding", x, 0.5, K1).d
+    for bad in (-1.0, 0.0, float("nan"), float("inf"), "foo", True):
+        with pytest.raises(ValueError, match="^range"):
+            error_bound("hoeffding", x, 0.5, K1, range=bad)

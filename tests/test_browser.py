@@ -103,7 +103,8 @@ def test_batch_size_explorer_matches_stored_runs(browser, book):
     (tests/test_browser_learner.py drives every control on a page of its own)."""
     import json
 
-    from safepg.thesis.experiments import get_experiment, load_experiment
+    from safepg.thesis.experiment_store import load_experiment
+    from safepg.thesis.experiments import get_experiment
     from safepg.thesis.explorers.live_learner import TITLE, live_batch_size_explorer
 
     pg = OfflinePage(browser, book / "book" / "lqg1d.html", height=1600)

@@ -57,11 +57,12 @@ def python_run_seconds(params: dict) -> float:
 
     from safepg.envs.lqg import LQG
     from safepg.learning import adaptive_pg
+    from safepg.options import ErrorModel, Gradient
 
     bound, er = (params["bound"].removesuffix("-er"), params["bound"].endswith("-er"))
-    kw = dict(estimator=params["estimator"], baseline=params["baseline"] == "on", bound=bound, empirical_range=er,
-              delta=float(params["delta"]), score_action=params["score"], budget=int(params["budget"]),
-              rng=int(params["seed"]))
+    kw = dict(gradient=Gradient(params["estimator"], params["baseline"] == "on", params["score"]),
+              error=ErrorModel(bound, float(params["delta"]), "empirical" if er else "lemma"),
+              budget=int(params["budget"]), rng=int(params["seed"]))
     before = numba.get_num_threads()
     numba.set_num_threads(1)
     try:

@@ -10,7 +10,8 @@ import pytest
 
 from safepg.runner import TIMING_FILE
 from safepg.thesis import budget
-from safepg.thesis.experiments import experiment_folder, get_experiment, run_experiment, scaled
+from safepg.thesis.experiment_store import experiment_folder, run_experiment
+from safepg.thesis.experiments import get_experiment, scaled
 
 ROOT = Path(__file__).resolve().parents[1]
 

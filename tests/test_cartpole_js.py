@@ -43,6 +43,7 @@ from test_learner2d_js import (
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole, step_dynamics
 from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.options import Batches, Departures, ErrorModel, FixedStep
 from safepg.policies import LinearGaussianPolicy
 from safepg.thesis.authors import cartpole_theta_star
 from safepg.thesis.experiments import AUTHORS_DOUBLED
@@ -110,17 +111,16 @@ def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     seed, budget, task = 6, 9000, AUTHORS
     if kind == "adaptive-authors":
-        py = adaptive_pg(task, THETA_STAR, 1.0, bound="bernstein", empirical_range=True, n_first=1000, n_min=10,
-                         constants="batch", statistics="max", step_when_unsafe=True, budget=budget, rng=seed)
+        py = adaptive_pg(task, THETA_STAR, 1.0, budget=budget, rng=seed, **_ADAPTIVE_AUTHORS)
         cfg = {"bound": "bernstein", "empiricalRange": True, "nFirst": 1000, "nMin": 10, "constants": "batch",
                "statistics": "max", "stepWhenUnsafe": True}
     elif kind == "coordinate-authors":
-        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, alpha=0.01, step="coordinate", budget=budget,
+        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, step=FixedStep(0.01, "coordinate"), budget=budget,
                         rng=seed)
         cfg = {"algorithm": "vanilla", "batchSize": 1000, "alpha": 0.01, "step": "coordinate"}
     else:
         task = THESIS
-        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, alpha=1e-3, budget=budget, rng=seed)
+        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, step=FixedStep(1e-3), budget=budget, rng=seed)
         cfg = {"algorithm": "vanilla", "batchSize": 1000, "alpha": 1e-3}
     U, Z = replay_draws(seed, py.batch_size, 4, task.horizon)
     js = run_node({"replay": {"cfg": {**cfg, "budget": budget, "theta0": THETA_STAR.tolist()},
@@ -136,8 +136,8 @@ def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
 
 # --------------------------------------------------------------------------- stochastic parts
 SEEDS = 30
-_ADAPTIVE_AUTHORS = dict(bound="bernstein", empirical_range=True, n_first=1000, n_min=10, constants="batch",
-                         statistics="max", step_when_unsafe=True)
+_ADAPTIVE_AUTHORS = dict(error=ErrorModel("bernstein", range="empirical"), batches=Batches(n_min=10, first=1000),
+                         departures=Departures(batch_constants=True, maxima=True, unguarded_step=True))
 #: name -> (task, safepg call, the JavaScript cfg); budgets of a few thousand episodes.
 SETTINGS: dict[str, tuple[CartPole, Any, dict[str, Any]]] = {
     "authors' adaptive (Table 5.4), 5000": (
@@ -145,15 +145,15 @@ SETTINGS: dict[str, tuple[CartPole, Any, dict[str, Any]]] = {
         {"bound": "bernstein", "empiricalRange": True, "nFirst": 1000, "nMin": 10, "constants": "batch",
          "statistics": "max", "stepWhenUnsafe": True, "budget": 5000}),
     "authors' N = 1000, coordinate alpha = 0.01, 5000": (
-        AUTHORS, lambda s: vanilla_pg(AUTHORS, THETA_STAR, 1.0, batch_size=1000, alpha=0.01, step="coordinate",
-                                      budget=5000, rng=s),
+        AUTHORS, lambda s: vanilla_pg(AUTHORS, THETA_STAR, 1.0, batch_size=1000,
+                                      step=FixedStep(0.01, "coordinate"), budget=5000, rng=s),
         {"algorithm": "vanilla", "batchSize": 1000, "alpha": 0.01, "step": "coordinate", "budget": 5000}),
     "thesis task, N = 500, scalar alpha = 0.01, 4000": (
-        THESIS, lambda s: vanilla_pg(THESIS, THETA_STAR, 1.0, batch_size=500, alpha=0.01, budget=4000, rng=s),
+        THESIS, lambda s: vanilla_pg(THESIS, THETA_STAR, 1.0, batch_size=500, step=FixedStep(0.01), budget=4000, rng=s),
         {"algorithm": "vanilla", "batchSize": 500, "alpha": 0.01, "budget": 4000}),
     "thesis text's adaptive (theta frozen), 3000": (
-        THESIS, lambda s: adaptive_pg(THESIS, THETA_STAR, 1.0, bound="bernstein", empirical_range=True, budget=3000,
-                                      rng=s),
+        THESIS, lambda s: adaptive_pg(THESIS, THETA_STAR, 1.0, error=ErrorModel("bernstein", range="empirical"),
+                                      budget=3000, rng=s),
         {"bound": "bernstein", "empiricalRange": True, "budget": 3000}),
 }
 

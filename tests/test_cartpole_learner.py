@@ -13,33 +13,33 @@ import pytest
 from ch5_node import NODE, run_page
 
 from safepg.envs.cartpole import CartPole
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import learn
+from safepg.options import FixedStep
 from safepg.thesis.authors import cartpole_theta_star
 from safepg.thesis.experiments import get_experiment
 from safepg.thesis.explorers.cartpole_learner import (
     SETTINGS,
-    adaptive_options,
+    adaptive_method,
     cartpole_explorer,
     cartpole_result,
     cartpole_task,
     task_fields,
-    vanilla_options,
+    vanilla_method,
 )
 from safepg.thesis.explorers.ch5_live import record_c, record_trace
-from safepg.thesis.explorers.js_tasks import cartpole_task_data
+from safepg.thesis.explorers.js_tasks import cartpole_task_data, learner_options
 
 needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
 BOXES = [name for name, *_ in SETTINGS]
-#: Each box: the CartPole fields and adaptive_pg options it sets, and nothing else.
+#: Each box: the CartPole fields and the options of Algorithm 4.1 it sets (under the page learner's
+#: names, js_tasks.learner_options), and nothing else.
 EXPECTED = {"gamma09": ({"gamma": 1.0, "constants_gamma": 0.9}, {}),
             "batch_constants": ({}, {"constants": "batch"}),
             "max_stats": ({}, {"statistics": "max"}),
-            "unguarded": ({}, {"step_when_unsafe": True}),
-            "first1000": ({}, {"n_first": 1000, "n_min": 10}),
+            "unguarded": ({}, {"stepWhenUnsafe": True}),
+            "first1000": ({}, {"nFirst": 1000, "nMin": 10}),
             "deg12": ({"angle_threshold_deg": 12.0}, {}),
             "ml005": ({"polemass_length": 0.05}, {})}
-CAMEL = {"empirical_range": "empiricalRange", "n_min": "nMin", "n_first": "nFirst", "step_when_unsafe":
-         "stepWhenUnsafe", "batch_size": "batchSize", "stop_on_divergence": "stopOnDivergence"}
 
 
 @pytest.fixture(scope="module")
@@ -50,34 +50,31 @@ def explorer():
 def test_each_box_sets_its_option_and_only_it(explorer):
     p0 = explorer.defaults()
     assert not any(p0[b] for b in BOXES) and set(EXPECTED) == set(BOXES)
-    base_opts, base_task = adaptive_options(p0), CartPole.thesis_doubled()
+    base_opts, base_task = learner_options(adaptive_method(p0)), CartPole.thesis_doubled()
     assert task_fields(p0) == {} and cartpole_task(p0) == base_task
     for box, (fields, options) in EXPECTED.items():
         p = {**p0, box: True}
         assert task_fields(p) == fields, box
         assert cartpole_task(p) == CartPole.thesis_doubled(**fields)
-        changed = {k: v for k, v in adaptive_options(p).items() if base_opts[k] != v}
+        changed = {k: v for k, v in learner_options(adaptive_method(p)).items() if base_opts[k] != v}
         assert changed == options, box
-        assert vanilla_options(p) == vanilla_options(p0)  # the fixed-step method is table-5.4's throughout
 
 
 def test_no_box_is_table_5_4_and_every_box_is_table_5_4_authors(explorer):
     p0 = explorer.defaults()
     thesis = get_experiment("table-5.4").config("adaptive")
-    opts = adaptive_options(p0)
-    assert (opts["bound"], opts["empirical_range"], opts["delta"], opts["n_min"]) == \
-        (thesis.bound, thesis.empirical_range, thesis.delta, thesis.n_min)
+    assert adaptive_method(p0) == thesis.method
     assert cartpole_task(p0).setting_name() == thesis.env == "cartpole-doubled"
     authors = get_experiment("table-5.4-authors-theta-star").config("adaptive")
     p1 = {**p0, **{b: True for b in BOXES}}
-    opts = adaptive_options(p1)
-    for k in ("bound", "empirical_range", "delta", "n_min", "n_first", "constants", "statistics", "step_when_unsafe"):
-        assert opts[k] == getattr(authors, k), k
+    method = adaptive_method(p1)
+    assert (method.error, method.batches, method.departures) == (
+        authors.method.error, authors.method.batches, authors.method.departures)
     assert cartpole_task(p1).setting_name() == authors.env
     assert explorer.data["starts"]["theta_star"] == list(authors.theta0) == cartpole_theta_star().tolist()
     van = get_experiment("table-5.4").config("N=4000")
-    v = vanilla_options(p0)
-    assert (v["batch_size"], v["alpha"], v["step"]) == (van.batch_size, van.alpha, van.step)
+    assert vanilla_method() == van.method  # the fixed-step method is table-5.4's, whatever the boxes
+    assert (van.method.batch_size, van.method.step) == (4000, FixedStep(0.01))
 
 
 def test_presets_and_starts(explorer):
@@ -104,20 +101,26 @@ def test_page_sends_the_engine_the_twins_settings(explorer):
         p = {**p0, **m}
         runs = {r["name"]: r["cfg"] for r in got["configs"]["runs"]}
         assert got["configs"]["task"] == cartpole_task_data(cartpole_task(p))
-        for name, kw in (("adaptive", adaptive_options(p)), ("vanilla", vanilla_options(p))):
+        for name, method in (("adaptive", adaptive_method(p)), ("vanilla", vanilla_method())):
             cfg = runs[name]
             assert cfg["algorithm"] == name and cfg["sigma"] == p["sigma"] and cfg["seed"] == round(p["seed"])
-            assert cfg["theta0"] == explorer.data["starts"][p["start"]]
-            for k, v in kw.items():
-                assert cfg[CAMEL.get(k, k)] == v, (m, name, k)
+            assert cfg["theta0"] == explorer.data["starts"][p["start"]] and cfg["budget"] == int(p["budget"])
+            for k, v in learner_options(method).items():
+                if k not in cfg:  # the page leaves out what is at the learner's default
+                    assert (k, v) == ("theoreticalRange", None), (m, name, k)
+                elif not (name == "vanilla" and k in ("bound", "empiricalRange", "delta")):  # no bound in a fixed step
+                    assert cfg[k] == v, (m, name, k)
+            if name == "vanilla":
+                assert cfg["stopOnDivergence"] is True  # learn() stops a diverging vanilla run
 
 
 def traces_of(p, data, budget=3000):
     task, theta0 = cartpole_task(p), np.asarray(data["starts"][p["start"]])
-    kw = {**adaptive_options(p), "budget": budget}
-    rec = adaptive_pg(task, theta0, 1.0, rng=np.random.default_rng(0), **kw)
-    van = vanilla_pg(task, theta0, 1.0, rng=np.random.default_rng(1), **{**vanilla_options(p), "budget": 8000})
-    return {"adaptive": record_trace(rec, record_c(rec, kw["constants"])), "vanilla": record_trace(van)}
+    method = adaptive_method(p)
+    rec = learn(task, method, theta0, 1.0, budget=budget, rng=np.random.default_rng(0))
+    van = learn(task, vanilla_method(), theta0, 1.0, budget=8000, rng=np.random.default_rng(1))
+    return {"adaptive": record_trace(rec, record_c(rec, method.departures.batch_constants)),
+            "vanilla": record_trace(van)}
 
 
 @needs_node

@@ -14,6 +14,7 @@ from safepg.envs.cartpole import NORMALISED_SCALE, CartPole
 from safepg.estimators import gradient_samples
 from safepg.learning import LearningRecord
 from safepg.meta import penalty_constant
+from safepg.options import ErrorModel, FixedStep
 from safepg.policies import LinearGaussianPolicy
 from safepg.thesis.cartpole_sweep import (
     CAN_MOVE_SHARE,
@@ -29,7 +30,8 @@ from safepg.thesis.cartpole_sweep import (
     sweep_summary,
     sweep_table,
 )
-from safepg.thesis.experiments import CARTPOLE_SWEEP, EXPERIMENTS, SWEEP_BUDGET, get_experiment, make_env
+from safepg.thesis.experiments import EXPERIMENTS, get_experiment, make_env
+from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BUDGET
 
 #: c of our default doubled-pole setting (R 1, M_phi 10, |A| 20, gamma 0.99, sigma 1), as the chapter prints it.
 DEFAULT_C = 57478845.60802851
@@ -184,15 +186,15 @@ def test_sweep_experiments_are_well_formed() -> None:
     names = {c.name for c in exp.configs}
     for st in CARTPOLE_SWEEP.values():
         base = get_experiment(st.baseline_experiment)
-        assert len(base.configs) == 1 and base.configs[0].target_return == 195.0
+        assert len(base.configs) == 1 and base.configs[0].method.target.value == 195.0
         if st.task and st.warm_start is None:  # its own baseline, on its own 1 m task
             assert make_env(base.configs[0].env) == CartPole.thesis(**st.task)
         if not st.doubled:
             assert f"{st.key}:adaptive" not in names
             continue
         ad = exp.config(f"{st.key}:adaptive")
-        assert (ad.algorithm, ad.bound, ad.empirical_range, ad.delta, ad.budget) == (
-            "adaptive", "bernstein", True, 0.95, SWEEP_BUDGET)
+        assert (ad.algorithm, ad.method.error, ad.budget) == ("adaptive", ErrorModel("bernstein", 0.95, "empirical"),
+                                                              SWEEP_BUDGET)
         assert ad.warm_start == st.baseline_experiment
         assert make_env(ad.env) == CartPole.thesis_doubled(**st.task, **st.constants)
         # The bound constants alone do not change the vanilla run: shared with the default's.
@@ -200,7 +202,7 @@ def test_sweep_experiments_are_well_formed() -> None:
         assert (van in names) == (not st.constants or bool(st.task))
         if van in names:
             v = exp.config(van)
-            assert (v.batch_size, v.alpha, v.warm_start) == (4000, 0.01, st.baseline_experiment)
+            assert (v.method.batch_size, v.method.step, v.warm_start) == (4000, FixedStep(0.01), st.baseline_experiment)
             assert make_env(v.env) == CartPole.thesis_doubled(**st.task)
     assert "cartpole-sweep" in EXPERIMENTS and "thesis:N=4000" in names
 

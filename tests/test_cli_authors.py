@@ -13,6 +13,7 @@ import pytest
 from safepg.cli import main
 from safepg.thesis import authors
 from safepg.thesis import experiments as ex
+from safepg.thesis import report as rp
 
 
 @pytest.fixture()
@@ -44,7 +45,8 @@ def test_report_of_table_5_1_authors(root, capsys):
         assert row["rules"] == "authors" and row["seeds"] == 1
         assert row["thesis"] == ex.get_experiment("table-5.1").thesis[cfg.name]  # the printed value
         out = row["authors_output"]
-        assert out["improvement_ratio"] == theirs[(cfg.sigma, cfg.batch_size, cfg.alpha)]["improvement_ratio"]
+        cell = (cfg.sigma, cfg.method.batch_size, cfg.method.step.alpha)
+        assert out["improvement_ratio"] == theirs[cell]["improvement_ratio"]
         assert out["theta0"] == -0.575853
     slip = next(r for r in rep["configs"] if r["name"] == "sigma=1.0-N=1000-alpha=1e-03")
     assert slip["thesis"]["improvement_ratio"] == 0.374 and slip["authors_output"]["increases"] == 376
@@ -67,7 +69,7 @@ def test_report_of_table_5_4_authors_theta_star(root, capsys):
 def test_report_of_other_experiments_has_no_authors_output(root, capsys):
     rep = run_and_report("table-5.3-authors", 3000, capsys)
     assert rep["configs"][0]["authors_output"]["upsilon_bar"] == pytest.approx(-20.4973, abs=1e-4)
-    rep = ex.report(ex.scaled(ex.get_experiment("table-5.3"), seeds=1, budget=3000), {})
+    rep = rp.report(ex.scaled(ex.get_experiment("table-5.3"), seeds=1, budget=3000), {})
     assert all(r["authors_output"] is None for r in rep["configs"])
 
 

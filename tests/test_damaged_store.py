@@ -25,11 +25,14 @@ from safepg import runner, store
 from safepg.cli import main
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, RecordFileError, adaptive_pg, vanilla_pg
+from safepg.options import FixedStep
+from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
+from safepg.thesis import report as rp
 
 
 def _record() -> LearningRecord:
-    return vanilla_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, batch_size=100, alpha=1e-4, budget=1000, rng=0)
+    return vanilla_pg(LQG.thesis_1d(), np.array([-0.3]), 1.0, batch_size=100, step=FixedStep(1e-4), budget=1000, rng=0)
 
 
 def _save_arrays(path: Path, rec: LearningRecord, **change) -> None:
@@ -124,14 +127,14 @@ def small(seeds=2):
 
 
 def _files(exp):
-    folder = ex.experiment_folder(exp)
+    folder = es.experiment_folder(exp)
     return [runner.run_path(folder, c, k) for c in exp.configs for k in range(exp.seeds)]
 
 
 def test_run_sets_damaged_files_aside_and_computes_them_again(root, tmp_path_factory):
     exp = small(seeds=3)
-    clean = ex.run_experiment(exp, jobs=1, progress=False, root=tmp_path_factory.mktemp("clean"))
-    ex.run_experiment(exp, jobs=1, progress=False)
+    clean = es.run_experiment(exp, jobs=1, progress=False, root=tmp_path_factory.mktemp("clean"))
+    es.run_experiment(exp, jobs=1, progress=False)
     files = _files(exp)
     hows = ["truncated", "garbage", "empty", "wrong shape", "bad crc"]
     kept = {}
@@ -140,9 +143,9 @@ def test_run_sets_damaged_files_aside_and_computes_them_again(root, tmp_path_fac
         kept[path] = path.read_bytes()
     untouched = {p: p.stat().st_mtime_ns for p in files[len(hows):]}
     with pytest.warns(store.DamagedRunWarning) as caught:
-        again = ex.run_experiment(exp, jobs=1, progress=False)
+        again = es.run_experiment(exp, jobs=1, progress=False)
     assert_same_records(clean, again)
-    assert_same_records(clean, ex.load_experiment(exp))
+    assert_same_records(clean, es.load_experiment(exp))
     assert len(caught) == len(hows)
     for path, w in zip(files, caught):
         (aside,) = path.parent.glob(f"{path.name}{store.DAMAGED_SUFFIX}*")
@@ -153,23 +156,23 @@ def test_run_sets_damaged_files_aside_and_computes_them_again(root, tmp_path_fac
     # Set aside once: the next run reads everything and warns about nothing.
     with warnings.catch_warnings():
         warnings.simplefilter("error", store.DamagedRunWarning)
-        ex.run_experiment(exp, jobs=1, progress=False)
+        es.run_experiment(exp, jobs=1, progress=False)
 
 
 def test_readers_leave_damaged_files_out_and_in_place(root):
     exp = small()
-    ex.run_experiment(exp, jobs=1, progress=False)
+    es.run_experiment(exp, jobs=1, progress=False)
     files = _files(exp)
     _damage(files[0], "truncated")
     _damage(files[3], "garbage")
     with pytest.warns(store.DamagedRunWarning, match="left out") as caught:
-        recs = ex.load_experiment(exp)
+        recs = es.load_experiment(exp)
     assert [len(recs[c.name]) for c in exp.configs] == [1, 1] and len(caught) == 2
     with pytest.warns(store.DamagedRunWarning):
-        rep = ex.report(exp)  # the book's read-only pages (the scorecard) go on too
+        rep = rp.report(exp)  # the book's read-only pages (the scorecard) go on too
     assert [r["seeds"] for r in rep["configs"]] == [1, 1]
     with pytest.raises(store.DamagedRunsError) as info:
-        ex.load_experiment(exp, on_damaged="raise")
+        es.load_experiment(exp, on_damaged="raise")
     assert [d.path for d in info.value.damaged] == [files[0], files[3]]  # every one, not just the first
     assert not list(root.rglob(f"*{store.DAMAGED_SUFFIX}*"))
 
@@ -178,13 +181,13 @@ def test_stale_files_are_recomputed_silently(root, monkeypatch):
     """Another RESULTS_VERSION (or other settings) is not damage: overwritten, nothing set aside."""
     exp = small(seeds=1)
     monkeypatch.setattr(runner, "RESULTS_VERSION", "0")
-    old = ex.run_experiment(exp, jobs=1, progress=False)
+    old = es.run_experiment(exp, jobs=1, progress=False)
     monkeypatch.undo()
     monkeypatch.setenv("SAFEPG_RESULTS", str(root))
     with warnings.catch_warnings():
         warnings.simplefilter("error", store.DamagedRunWarning)
-        assert ex.load_experiment(exp) == {c.name: [] for c in exp.configs}
-        new = ex.run_experiment(exp, jobs=1, progress=False)
+        assert es.load_experiment(exp) == {c.name: [] for c in exp.configs}
+        new = es.run_experiment(exp, jobs=1, progress=False)
     assert not list(root.rglob(f"*{store.DAMAGED_SUFFIX}*"))
     assert all(len(new[c.name]) == 1 for c in exp.configs)
     assert not np.array_equal(old[exp.configs[0].name][0].theta, new[exp.configs[0].name][0].theta)
@@ -209,17 +212,19 @@ def test_set_aside_leaves_a_file_another_runner_already_replaced(tmp_path):
 def test_warm_start_sets_a_damaged_starting_run_aside(root, monkeypatch):
     """A warm-started experiment whose starting run is damaged sets it aside and starts from its recomputation."""
     base = ex.get_experiment("cartpole-baseline")
-    cheap = ex.scaled(replace(base, configs=(replace(base.configs[0], target_return=None),)), seeds=1, budget=8000)
+    b0 = base.configs[0]
+    cheap = ex.scaled(replace(base, configs=(replace(b0, method=replace(b0.method, target=None)),)), seeds=1,
+                      budget=8000)
     monkeypatch.setitem(ex.EXPERIMENTS, "cartpole-baseline", cheap)
     t54 = ex.get_experiment("table-5.4")
     warm = ex.scaled(replace(t54, configs=t54.configs[:1]), seeds=1, budget=4000)
-    first = ex.run_experiment(warm, root=root)[warm.configs[0].name][0]
-    path = runner.run_path(ex.experiment_folder(cheap, root), cheap.configs[0], 0)
+    first = es.run_experiment(warm, root=root)[warm.configs[0].name][0]
+    path = runner.run_path(es.experiment_folder(cheap, root), cheap.configs[0], 0)
     _damage(path, "truncated")
-    for stored in ex.experiment_folder(warm, root).rglob("seed-0.npz"):
+    for stored in es.experiment_folder(warm, root).rglob("seed-0.npz"):
         stored.unlink()  # so the warm-started run is computed again, from the recomputed start
     with pytest.warns(store.DamagedRunWarning, match="set aside"):
-        again = ex.run_experiment(warm, root=root)[warm.configs[0].name][0]
+        again = es.run_experiment(warm, root=root)[warm.configs[0].name][0]
     assert list(path.parent.glob(f"seed-0.npz{store.DAMAGED_SUFFIX}*"))
     np.testing.assert_array_equal(again.theta, first.theta)
 
@@ -268,7 +273,7 @@ def test_the_command_line_on_a_damaged_folder(tmp_path):
 
 def test_cli_report_lists_every_damaged_file(root, capsys):
     exp = small()
-    ex.run_experiment(exp, jobs=1, progress=False)
+    es.run_experiment(exp, jobs=1, progress=False)
     for path, how in zip(_files(exp), ("empty", "wrong shape", "missing array")):
         _damage(path, how)
     capsys.readouterr()

@@ -1,6 +1,7 @@
 """Experiment runner: definitions, resume, invalidation, report, CLI."""
 
 import json
+from collections import defaultdict
 from dataclasses import replace
 
 import numpy as np
@@ -8,13 +9,21 @@ import pytest
 
 from safepg import runner, stats, store
 from safepg.cli import main
+from safepg.options import Departures, FixedStep
+from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
+from safepg.thesis import report as rp
 
 
 @pytest.fixture()
 def root(tmp_path, monkeypatch):
     monkeypatch.setenv("SAFEPG_RESULTS", str(tmp_path))
     return tmp_path
+
+
+def flat(c):
+    """A config's settings under their flat names (RunConfig.fields()), None where unset."""
+    return defaultdict(lambda: None, c.fields())
 
 
 def small(name="table-5.2", configs=3, budget=3000, seeds=2):
@@ -25,15 +34,16 @@ def small(name="table-5.2", configs=3, budget=3000, seeds=2):
 def test_definitions_match_the_thesis():
     t51, t52 = ex.get_experiment("table-5.1"), ex.get_experiment("table-5.2")
     assert len(t51.configs) == 24 and {c.budget for c in t51.configs} == {1_000_000}
-    assert {(c.sigma, c.batch_size, c.alpha) for c in t51.configs} == {
+    assert {(c.sigma, c.method.batch_size, c.method.step.alpha) for c in t51.configs} == {
         (s, n, a) for s in (0.5, 1.0) for n in (10_000, 1_000, 100) for a in (1e-3, 1e-4, 1e-5, 1e-6)}
     # Run from the reconstructed theta_0 = -0.575 (the thesis prints -0.55: table-5.1-printed-theta0).
-    assert all(c.theta0 == (-0.575,) and c.estimator == "gpomdp" and c.baseline for c in t51.configs)
+    assert all(c.theta0 == (-0.575,) and c.method.gradient.estimator == "gpomdp" and c.method.gradient.baseline
+               for c in t51.configs)
     printed = ex.get_experiment("table-5.1-printed-theta0")
     assert [replace(c, theta0=(-0.575,)) for c in printed.configs] == list(t51.configs)
     assert len(t52.configs) == 12 and t52.seeds == 5
     assert all(c.budget == 30_000_000 and c.theta0 == (0.0,) and c.sigma == 1.0 for c in t52.configs)
-    assert sum(c.estimator == "reinforce" for c in t52.configs) == 3
+    assert sum(c.method.gradient.estimator == "reinforce" for c in t52.configs) == 3
     assert len({c.key() for c in t52.configs}) == 12
     for c in t52.configs:
         lo, hi = t52.thesis[c.name]["ci95"]
@@ -42,27 +52,29 @@ def test_definitions_match_the_thesis():
 
 def test_run_resume_and_invalidation(root, monkeypatch):
     exp = small()
-    recs = ex.run_experiment(exp, jobs=1, progress=False)
+    recs = es.run_experiment(exp, jobs=1, progress=False)
     assert all(len(v) == 2 for v in recs.values())
     files = sorted(root.rglob("*.npz"))
     assert len(files) == 6
     stamp = {f: f.stat().st_mtime_ns for f in files}
     calls = []
     monkeypatch.setattr(ex.RunConfig, "run", lambda self, k, progress=False, theta0=None: calls.append((self.name, k)))
-    again = ex.run_experiment(exp, jobs=1, progress=False)
+    again = es.run_experiment(exp, jobs=1, progress=False)
     assert calls == [] and all(f.stat().st_mtime_ns == stamp[f] for f in files)
     for name in recs:
         assert all(np.array_equal(a.theta, b.theta) for a, b in zip(recs[name], again[name]))
     # Changing one config's settings invalidates only its runs.
-    changed = replace(exp, configs=(replace(exp.configs[0], delta=0.9),) + exp.configs[1:])
-    assert runner.stored_run(ex.experiment_folder(changed), changed.configs[0], 0) is None
-    assert runner.stored_run(ex.experiment_folder(changed), changed.configs[1], 0) is not None
+    c0 = exp.configs[0]
+    c0 = replace(c0, method=replace(c0.method, error=replace(c0.method.error, delta=0.9)))
+    changed = replace(exp, configs=(c0,) + exp.configs[1:])
+    assert runner.stored_run(es.experiment_folder(changed), changed.configs[0], 0) is None
+    assert runner.stored_run(es.experiment_folder(changed), changed.configs[1], 0) is not None
 
 
 def test_same_results_in_parallel_and_serial(root, tmp_path_factory):
     exp = small(configs=2, seeds=2)
-    serial = ex.run_experiment(exp, jobs=1, progress=False)
-    par = ex.run_experiment(exp, jobs=2, progress=False, root=tmp_path_factory.mktemp("par"))
+    serial = es.run_experiment(exp, jobs=1, progress=False)
+    par = es.run_experiment(exp, jobs=2, progress=False, root=tmp_path_factory.mktemp("par"))
     for name in serial:
         assert all(np.array_equal(a.theta, b.theta) for a, b in zip(serial[name], par[name]))
 
@@ -70,20 +82,20 @@ def test_same_results_in_parallel_and_serial(root, tmp_path_factory):
 def test_interrupted_or_partial_files_are_recomputed(root):
     exp = small(configs=1, seeds=1)
     cfg = exp.configs[0]
-    path = runner.run_path(ex.experiment_folder(exp), cfg, 0)
+    path = runner.run_path(es.experiment_folder(exp), cfg, 0)
     path.parent.mkdir(parents=True)
     path.write_bytes(b"half a file")
     with pytest.warns(store.DamagedRunWarning, match="left out"):
         assert store.load_stored(path, cfg.key()) is None
     with pytest.warns(store.DamagedRunWarning, match="set aside"):  # kept: tests/test_damaged_store.py
-        ex.run_experiment(exp, jobs=1, progress=False)
+        es.run_experiment(exp, jobs=1, progress=False)
     assert store.load_stored(path, cfg.key()) is not None
     assert not list(path.parent.glob("*.tmp.npz"))
 
 
 def test_report_structure(root):
     exp = small(configs=2, seeds=3, budget=120_000)
-    rep = ex.report(exp, ex.run_experiment(exp, jobs=1, progress=False))
+    rep = rp.report(exp, es.run_experiment(exp, jobs=1, progress=False))
     assert rep["experiment"] == "table-5.2" and len(rep["configs"]) == 2
     row = rep["configs"][0]
     for key in ("name", "estimator", "bound", "empirical_range", "delta", "sigma", "seeds",
@@ -127,17 +139,18 @@ def test_sections_5_2_and_5_3_definitions():
     f55, t53 = ex.get_experiment("figures-5.5-5.6"), ex.get_experiment("table-5.3")
     for c in f55.configs + t53.configs:
         assert c.env == "lqg2d-gamma0.9" and c.theta0 == (0.0,) * 4 and c.budget == 30_000_000
-    assert {c.step for c in f55.configs} == {"scalar", "coordinate"}
-    assert all(c.batch_size == 2000 and c.alpha is None and c.bound == "chebyshev" and c.delta == 0.95
-               for c in f55.configs)
-    adaptive, n1000, n100 = t53.configs
-    assert (adaptive.algorithm, adaptive.bound, adaptive.empirical_range) == ("adaptive", "bernstein", True)
-    assert (n1000.batch_size, n1000.alpha, n100.batch_size, n100.alpha) == (1000, 1e-6, 100, 1e-6)
+    assert {flat(c)["step"] for c in f55.configs} == {"scalar", "coordinate"}
+    assert all(flat(c)["batch_size"] == 2000 and flat(c)["alpha"] is None and flat(c)["bound"] == "chebyshev"
+               and flat(c)["delta"] == 0.95 for c in f55.configs)
+    adaptive, n1000, n100 = (flat(c) for c in t53.configs)
+    assert (adaptive["algorithm"], adaptive["bound"], adaptive["empirical_range"]) == ("adaptive", "bernstein", True)
+    assert (n1000["batch_size"], n1000["alpha"], n100["batch_size"], n100["alpha"]) == (1000, 1e-6, 100, 1e-6)
     env = ex.make_env("lqg2d-gamma0.9")
     assert env.dim == 2 and env.gamma == 0.9 and ex.make_env("lqg2d").gamma == 0.95
     base, t54 = ex.get_experiment("cartpole-baseline"), ex.get_experiment("table-5.4")
     (b,) = base.configs
-    assert (b.env, b.batch_size, b.alpha, b.target_return) == ("cartpole", 4000, 0.01, 195.0)
+    assert (b.env, flat(b)["batch_size"], flat(b)["alpha"], flat(b)["target_return"]) == ("cartpole", 4000, 0.01,
+                                                                                         195.0)
     assert {c.env for c in t54.configs} == {"cartpole-doubled"} and len({c.budget for c in t54.configs}) == 1
     assert all(c.warm_start == "cartpole-baseline" for c in t54.configs)
     assert base.performance == t54.performance == "J_hat" and t53.performance == "J"
@@ -147,15 +160,16 @@ def test_sections_5_2_and_5_3_definitions():
 def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
     base = ex.scaled(ex.get_experiment("cartpole-baseline"), seeds=2)
     # A cheap stand-in for the baseline: the same experiment name, two iterations.
-    cheap = replace(base, configs=(replace(base.configs[0], budget=8000, target_return=None),))
+    b0 = base.configs[0]
+    cheap = replace(base, configs=(replace(b0, budget=8000, method=replace(b0.method, target=None)),))
     t54 = ex.scaled(ex.get_experiment("table-5.4"), seeds=2, budget=12_000)
     import safepg.thesis.experiments as mod
 
     saved = dict(mod.EXPERIMENTS)
     mod.EXPERIMENTS["cartpole-baseline"] = cheap
     try:
-        recs = ex.run_experiment(t54, jobs=1, progress=False)
-        baselines = ex.load_experiment(cheap)["baseline"]
+        recs = es.run_experiment(t54, jobs=1, progress=False)
+        baselines = es.load_experiment(cheap)["baseline"]
         assert len(baselines) == 2 and all(r.iterations == 2 for r in baselines)
         for name in ("adaptive", "N=4000"):
             for k, r in enumerate(recs[name]):
@@ -165,12 +179,12 @@ def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
         key = t54.configs[0].key()
         assert t54.configs[0].warm_start_key == saved[
             "cartpole-baseline"].configs[0].key()
-        other_start = replace(cheap.configs[0], alpha=0.02)
+        other_start = replace(cheap.configs[0], method=replace(cheap.configs[0].method, step=FixedStep(0.02)))
         assert replace(t54.configs[0], warm_start_key=other_start.key()).key() != key
     finally:
         mod.EXPERIMENTS.clear()
         mod.EXPERIMENTS.update(saved)
-    rep = ex.report(t54, recs)
+    rep = rp.report(t54, recs)
     rows = {r["name"]: r for r in rep["configs"]}
     assert rows["adaptive"]["batch_size"] is None and rows["adaptive"]["alpha"] is None
     assert (rows["N=4000"]["batch_size"], rows["N=4000"]["alpha"]) == (4000, 0.01)
@@ -186,7 +200,7 @@ def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
 
 def test_report_lists_the_components_each_method_updated(root):
     exp = ex.scaled(ex.get_experiment("figures-5.5-5.6"), seeds=1, budget=20_000)
-    rows = {r["name"]: r for r in ex.report(exp, ex.run_experiment(exp, jobs=1, progress=False))["configs"]}
+    rows = {r["name"]: r for r in rp.report(exp, es.run_experiment(exp, jobs=1, progress=False))["configs"]}
     assert rows["coordinate"]["components_updated"] == [0, 3]  # only the diagonal moves
     assert rows["scalar"]["components_updated"] == [0, 1, 2, 3]
     assert rows["coordinate"]["improvement_ratio_on"] == "J"
@@ -202,29 +216,32 @@ def test_authors_experiments_are_the_library_settings_combined():
     assert [replace(c, theta0=(-0.575,)) for c in t51.configs] == list(ex.get_experiment("table-5.1").configs)
     base = ex.get_experiment("cartpole-baseline-authors").configs[0]
     assert ex.make_env(base.env) == CartPole(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9)
-    assert base.update_at_target and (base.batch_size, base.alpha, base.step, base.target_return) == (
+    fb = flat(base)
+    assert fb["update_at_target"] and (fb["batch_size"], fb["alpha"], fb["step"], fb["target_return"]) == (
         4000, 0.01, "scalar", 195.0)
     t54 = ex.get_experiment("table-5.4-authors")
     ad, fx = t54.config("adaptive"), t54.config("N=4000")
     assert ex.make_env(ad.env) == CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9,
                                                           polemass_length=0.05) == ex.make_env(fx.env)
-    assert (ad.n_first, ad.n_min, ad.n_max, ad.constants, ad.statistics, ad.step_when_unsafe) == (
+    fa, ff = flat(ad), flat(fx)
+    assert (fa["n_first"], fa["n_min"], fa["n_max"], fa["constants"], fa["statistics"], fa["step_when_unsafe"]) == (
         1000, 10, 500_000, "batch", "max", True)
-    assert (ad.bound, ad.empirical_range, ad.delta) == ("bernstein", True, 0.95)
-    assert (fx.step, fx.alpha, fx.batch_size) == ("coordinate", 0.01, 4000)
+    assert (fa["bound"], fa["empirical_range"], fa["delta"]) == ("bernstein", True, 0.95)
+    assert (ff["step"], ff["alpha"], ff["batch_size"]) == ("coordinate", 0.01, 4000)
     assert ad.budget == fx.budget == TABLE_5_4_BUDGET and t54.rules == "authors" and t54.thesis == ex.get_experiment(
         "table-5.4").thesis
     assert ad.warm_start == "cartpole-baseline-authors" and ad.warm_start_key == base.key()
     star = ex.get_experiment("table-5.4-authors-theta-star")
     assert all(c.warm_start is None and c.theta0 == tuple(cartpole_theta_star()) for c in star.configs)
     t53 = ex.get_experiment("table-5.3-authors").configs[0]
-    assert replace(t53, n_max=500_000, statistics=None, step_when_unsafe=None) == ex.get_experiment(
-        "table-5.3").config("adaptive")
+    algorithm = replace(t53.method, batches=replace(t53.method.batches, n_max=500_000), departures=Departures())
+    assert replace(t53, method=algorithm) == ex.get_experiment("table-5.3").config("adaptive")
     # Table 5.2's theoretical-range rows (the range 1280 already the authors'), their step unguarded.
     t52, t52a = ex.get_experiment("table-5.2"), ex.get_experiment("table-5.2-authors")
     assert [c.name for c in t52a.configs] == ["gpomdp-hoeffding-delta=0.95", "gpomdp-bernstein-delta=0.95"]
-    assert [replace(c, step_when_unsafe=None) for c in t52a.configs] == [t52.config(c.name) for c in t52a.configs]
-    assert all(c.step_when_unsafe and c.theoretical_range == 1280.0 for c in t52a.configs)
+    assert [replace(c, method=replace(c.method, departures=Departures())) for c in t52a.configs] == [
+        t52.config(c.name) for c in t52a.configs]
+    assert all(flat(c)["step_when_unsafe"] and flat(c)["theoretical_range"] == 1280.0 for c in t52a.configs)
     assert t52a.rules == "authors" and t52a.thesis == {c.name: t52.thesis[c.name] for c in t52a.configs}
 
 
@@ -232,12 +249,12 @@ def test_authors_experiment_runs_and_is_counted_their_way(root):
     from safepg.thesis.authors import budget_average, strict_improvement_ratio
 
     exp = ex.scaled(ex.get_experiment("table-5.4-authors-theta-star"), seeds=1, budget=12_000)
-    recs = ex.run_experiment(exp, jobs=1, progress=False)
+    recs = es.run_experiment(exp, jobs=1, progress=False)
     ad, fx = recs["adaptive"][0], recs["N=4000"][0]
     assert ad.batch_size[0] == 1000 and ad.config["constants"] == "batch" and fx.batch_size[0] == 4000
     assert np.all(np.count_nonzero(np.diff(fx.theta, axis=0), axis=1) <= 1)  # one component per update
     assert 180 < ad.J_hat[0] < 195  # the authors' first doubled-pole batch: 187.5
-    rows = {r["name"]: r for r in ex.report(exp, recs)["configs"]}
+    rows = {r["name"]: r for r in rp.report(exp, recs)["configs"]}
     for name, rec in (("adaptive", ad), ("N=4000", fx)):
         window = budget_average(rec.batch_size, rec.J_hat, 12_000)
         assert rows[name]["rules"] == "authors"
@@ -245,6 +262,6 @@ def test_authors_experiment_runs_and_is_counted_their_way(root):
         assert rows[name]["improvement_ratio"]["mean"] == window["improvement_ratio"]
     lqg = ex.scaled(replace(ex.get_experiment("table-5.1-authors"), configs=ex.get_experiment(
         "table-5.1-authors").configs[:1]), seeds=1, budget=60_000)
-    rec = ex.run_experiment(lqg, jobs=1, progress=False)[lqg.configs[0].name][0]
-    row = ex.report(lqg, {lqg.configs[0].name: [rec]})["configs"][0]
+    rec = es.run_experiment(lqg, jobs=1, progress=False)[lqg.configs[0].name][0]
+    row = rp.report(lqg, {lqg.configs[0].name: [rec]})["configs"][0]
     assert row["improvement_ratio"]["mean"] == strict_improvement_ratio(rec.J[:-1])  # 5 of 6 batch starts

@@ -21,6 +21,7 @@ from gymnasium import spaces  # noqa: E402
 from safepg.envs import GymTask  # noqa: E402
 from safepg.envs.gym_task import with_bias  # noqa: E402
 from safepg.learning import adaptive_pg, vanilla_pg  # noqa: E402
+from safepg.options import Batches, ErrorModel, FixedStep, Gradient  # noqa: E402
 from safepg.policies import LinearGaussianPolicy  # noqa: E402
 
 #: The counter env terminates once its state reaches this value.
@@ -83,7 +84,7 @@ def test_missing_bound_constant_is_named_where_the_bounds_need_it(missing: str) 
     with pytest.raises(ValueError, match=rf"^{missing} must be given: "):
         getattr(task, missing)
     with pytest.raises(ValueError, match=rf"^{missing} must be given: "):
-        adaptive_pg(task, 0.0, 1.0, n_min=4, budget=8, rng=0)
+        adaptive_pg(task, 0.0, 1.0, batches=Batches(n_min=4), budget=8, rng=0)
     with pytest.raises(ValueError, match=rf"^{missing} must be given: "):
         vanilla_pg(task, 0.0, 1.0, batch_size=4, budget=8, rng=0)
 
@@ -213,11 +214,11 @@ def test_pickled_task_simulates_the_same_batch() -> None:
 
 def test_learning_loops_accept_the_task() -> None:
     task = counter_task()
-    rec = vanilla_pg(task, 0.0, 1.0, batch_size=8, alpha=0.01, budget=32, rng=0)
+    rec = vanilla_pg(task, 0.0, 1.0, batch_size=8, step=FixedStep(0.01), budget=32, rng=0)
     assert rec.iterations == 4 and np.all(np.isnan(rec.J)) and np.all(np.isfinite(rec.J_hat))
     assert "GymTask('CounterEnv'" in rec.config["task"]
     task.close()
-    rec = adaptive_pg(task, 0.0, 1.0, n_min=8, n_max=16, budget=40, rng=0)  # simulating again after close
+    rec = adaptive_pg(task, 0.0, 1.0, batches=Batches(8, 16), budget=40, rng=0)  # simulating again after close
     assert rec.trajectories == 40
 
 
@@ -252,8 +253,8 @@ def monte_carlo_J(task: GymTask, theta: np.ndarray, n: int = 500, z: float = 2.5
 def test_vanilla_pg_improves_pendulum() -> None:
     task = upright_pendulum()
     start = time.perf_counter()
-    rec = vanilla_pg(task, np.zeros(2), SIGMA, batch_size=20, alpha=0.05, budget=600,
-                     score_action="raw", rng=0)
+    rec = vanilla_pg(task, np.zeros(2), SIGMA, batch_size=20, step=FixedStep(0.05), budget=600,
+                     gradient=Gradient(score_action="raw"), rng=0)
     J0, h0 = monte_carlo_J(task, rec.theta[0])
     J1, h1 = monte_carlo_J(task, rec.theta_final)
     print(f"vanilla PG on Pendulum-v1: J {J0:.2f} +- {h0:.2f} -> {J1:.2f} +- {h1:.2f} (99%), "
@@ -264,8 +265,8 @@ def test_vanilla_pg_improves_pendulum() -> None:
 def test_adaptive_pg_runs_on_pendulum() -> None:
     task = upright_pendulum()
     start = time.perf_counter()
-    rec = adaptive_pg(task, np.zeros(2), SIGMA, bound="bernstein", empirical_range=True,
-                      n_min=100, n_max=2000, budget=5000, score_action="raw", rng=0)
+    rec = adaptive_pg(task, np.zeros(2), SIGMA, error=ErrorModel("bernstein", range="empirical"),
+                      batches=Batches(100, 2000), budget=5000, gradient=Gradient(score_action="raw"), rng=0)
     assert rec.trajectories == 5000
     assert np.all(rec.batch_size[:-1] >= 100) and np.all(rec.batch_size <= 2000)  # the last one is cut to the budget
     assert np.all(np.isfinite(rec.alpha)) and np.all(rec.alpha >= 0)

@@ -36,6 +36,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant, scalar_step
+from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep
 from safepg.policies import LinearGaussianPolicy
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
@@ -245,8 +246,9 @@ def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, floa
     g = float(abs(grad[k]))
     step = np.zeros_like(grad)
     if cfg["algorithm"] == "vanilla":
-        eps = max(float(error_bound(cfg["bound"], x[:, i], cfg["delta"], k_task, "gpomdp",
-                                    cfg["empiricalRange"]).eps(n)) for i in range(grad.size))
+        grad_range = "empirical" if cfg["empiricalRange"] else "lemma"
+        eps = max(float(error_bound(cfg["bound"], x[:, i], cfg["delta"], k_task, "gpomdp", grad_range).eps(n))
+                  for i in range(grad.size))
         a = scalar_step(grad, eps, c_bounds) if cfg["step"] == "scalar" else coordinate_step(g, eps, c_bounds)
         if cfg["step"] == "scalar":
             step = a * grad
@@ -260,7 +262,8 @@ def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, floa
     spread = {}
     if cfg["statistics"] == "max":
         spread = dict(variance=float(np.var(x, axis=0, ddof=1).max()), sample_range=float(np.ptp(x, axis=0).max()))
-    eb = error_bound(cfg["bound"], x[:, k], cfg["delta"], batch_k, "gpomdp", cfg["empiricalRange"], None, **spread)
+    grad_range = "empirical" if cfg["empiricalRange"] else "lemma"
+    eb = error_bound(cfg["bound"], x[:, k], cfg["delta"], batch_k, "gpomdp", grad_range, **spread)
     eps = float(eb.eps(n))
     alpha = coordinate_step(g, eps, c, guarded=not cfg["stepWhenUnsafe"])
     step[k] = alpha * grad[k]
@@ -309,17 +312,23 @@ def test_bounds_and_steps_under_every_option(tmp_path):
     assert got[0]["c_bounds"] == pytest.approx(penalty_constant(k_task), rel=RTOL)
 
 
+#: The bound of the adaptive runs (Table 5.3): Bernstein with the batch's range.
+BERNSTEIN_ER = ErrorModel("bernstein", range="empirical")
+#: The authors' 2-D adaptive run: their N_max, the maxima over the components, the unguarded step.
+AUTHORS_OPTIONS = dict(error=BERNSTEIN_ER, batches=Batches(n_max=100_000),
+                       departures=Departures(maxima=True, unguarded_step=True))
+
+
 @pytest.mark.parametrize("kind", ["adaptive-authors", "scalar", "coordinate"])
 def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     seed, budget = 8, 40_000
     if kind == "adaptive-authors":
-        py = adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=budget, rng=seed,
-                         statistics="max", step_when_unsafe=True, n_max=100_000)
+        py = adaptive_pg(ENV, np.zeros(4), 1.0, budget=budget, rng=seed, **AUTHORS_OPTIONS)
         cfg = {"bound": "bernstein", "empiricalRange": True, "statistics": "max", "stepWhenUnsafe": True,
                "nMax": 100_000}
     else:
-        py = vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step=kind, budget=budget, rng=seed)
+        py = vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep(kind), budget=budget, rng=seed)
         cfg = {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": kind}
     U, Z = replay_draws(seed, py.batch_size, 2, ENV.horizon * 2)
     js = run_node({"replay": {"cfg": {**cfg, "budget": budget}, "task": TASK, "H": ENV.horizon,
@@ -337,23 +346,23 @@ SEEDS = 30
 #: name -> (safepg call, the JavaScript cfg); budgets small enough for a minute in all.
 SETTINGS: dict[str, tuple[Any, dict[str, Any]]] = {
     "adaptive, Bernstein (e.r.), 10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=100_000, rng=s),
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, error=BERNSTEIN_ER, budget=100_000, rng=s),
         {"bound": "bernstein", "empiricalRange": True, "budget": 100_000}),
     "adaptive, authors' options, 10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=100_000, rng=s,
-                              n_max=100_000, statistics="max", step_when_unsafe=True),
+        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, budget=100_000, rng=s, **AUTHORS_OPTIONS),
         {"bound": "bernstein", "empiricalRange": True, "budget": 100_000, "nMax": 100_000, "statistics": "max",
          "stepWhenUnsafe": True}),
     "scalar step of [24], N = 2000, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step="scalar", budget=100_000, rng=s),
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep("scalar"), budget=100_000,
+                             rng=s),
         {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "scalar", "budget": 100_000}),
     "coordinate step, N = 2000, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, alpha=None, step="coordinate", budget=100_000,
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep("coordinate"), budget=100_000,
                              rng=s),
         {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "coordinate", "budget": 100_000}),
     "N = 100, alpha = 10^-6, REINFORCE, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=100, alpha=1e-6, estimator="reinforce", budget=100_000,
-                             rng=s),
+        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=100, step=FixedStep(1e-6),
+                             gradient=Gradient("reinforce"), budget=100_000, rng=s),
         {"algorithm": "vanilla", "batchSize": 100, "alpha": 1e-6, "estimator": "reinforce", "budget": 100_000}),
 }
 

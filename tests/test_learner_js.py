@@ -39,6 +39,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
+from safepg.options import ErrorModel, FixedStep, Gradient
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.live_learner import (
     learner_js,
@@ -215,7 +216,7 @@ def test_bounds_step_and_batch_size_match_safepg():
         c = penalty_constant(k)
         n = x.size
         grad = float(x.reshape(-1, 1).sum(axis=0)[0] / n)  # what safepg.learning computes
-        eb = error_bound(bound, x, delta, k, est, er)
+        eb = error_bound(bound, x, delta, k, est, "empirical" if er else "lemma")
         g = abs(grad)
         eps = float(eb.eps(n))
         alpha = coordinate_step(g, eps, c)
@@ -289,8 +290,8 @@ def test_gradient_samples_match_numba_kernel(clip, tmp_path):
 def test_whole_run_with_safepgs_random_numbers(bound, er, estimator, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     env, budget, seed, sigma, delta = LQG.thesis_1d(), 60_000, 4, 0.8, 0.6
-    py = adaptive_pg(env, 0.0, sigma, estimator=estimator, bound=bound, empirical_range=er, delta=delta,
-                     budget=budget, rng=seed)
+    py = adaptive_pg(env, 0.0, sigma, gradient=Gradient(estimator),
+                     error=ErrorModel(bound, delta, "empirical" if er else "lemma"), budget=budget, rng=seed)
     # Redraw the same numbers: per batch, one key; trajectory i: its initial state, then H normals.
     rng = np.random.default_rng(seed)
     s0, z = [], []
@@ -323,14 +324,13 @@ def page_params(**over: Any) -> dict[str, Any]:
 def python_runs(p: dict[str, Any]) -> dict[str, Any]:
     """The records the kernel twin (live_learner.compute_py) makes for the controls p."""
     env, bound = LQG.thesis_1d(), p["bound"]
-    common = dict(estimator=p["estimator"], baseline=p["baseline"] == "on", budget=int(p["budget"]),
-                  score_action=p["score"])
-    recs = {"adaptive": adaptive_pg(env, 0.0, p["sigma"], bound=bound.replace("-er", ""), delta=p["delta"],
-                                    empirical_range=bound.endswith("-er"), rng=np.random.default_rng(int(p["seed"])),
+    common = dict(gradient=Gradient(p["estimator"], p["baseline"] == "on", p["score"]), budget=int(p["budget"]))
+    error = ErrorModel(bound.replace("-er", ""), p["delta"], "empirical" if bound.endswith("-er") else "lemma")
+    recs = {"adaptive": adaptive_pg(env, 0.0, p["sigma"], error=error, rng=np.random.default_rng(int(p["seed"])),
                                     **common)}
     if p["vanilla_n"] != "off":
         recs["vanilla"] = vanilla_pg(env, 0.0, p["sigma"], batch_size=int(p["vanilla_n"]),
-                                     alpha=float(p["vanilla_alpha"]), stop_on_divergence=True,
+                                     step=FixedStep(float(p["vanilla_alpha"])), stop_on_divergence=True,
                                      rng=np.random.default_rng([int(p["seed"]), 1]), **common)
     return recs
 
@@ -442,8 +442,9 @@ def agreement(bound: str, er: bool, estimator: str, sigma: float, seeds: int = S
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # one core (the machine is shared)
     try:
-        py = [adaptive_pg(env, 0.0, sigma, estimator=estimator, bound=bound, empirical_range=er, delta=0.95,
-                          budget=budget, rng=1000 + k) for k in range(seeds)]
+        py = [adaptive_pg(env, 0.0, sigma, gradient=Gradient(estimator),
+                          error=ErrorModel(bound, 0.95, "empirical" if er else "lemma"), budget=budget, rng=1000 + k)
+              for k in range(seeds)]
     finally:
         numba.set_num_threads(threads)
     values = {

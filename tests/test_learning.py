@@ -4,7 +4,6 @@ import hashlib
 import json
 import subprocess
 import sys
-from dataclasses import asdict
 
 import numpy as np
 import pytest
@@ -14,7 +13,9 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
+from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target
 from safepg.policies import LinearGaussianPolicy
+from safepg.tasks import MeasuredReturns
 
 ENV = LQG.thesis_1d()
 ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe")
@@ -26,14 +27,14 @@ def _equal(a: LearningRecord, b: LearningRecord) -> bool:
 
 @pytest.mark.parametrize("bound,er", [("chebyshev", False), ("hoeffding", True), ("bernstein", True)])
 def test_same_seed_same_record(bound, er):
-    kw = dict(bound=bound, empirical_range=er, budget=20_000)
+    kw = dict(error=ErrorModel(bound, range="empirical" if er else "lemma"), budget=20_000)
     a, b = adaptive_pg(ENV, rng=5, **kw), adaptive_pg(ENV, rng=5, **kw)
     assert _equal(a, b)
     assert not _equal(a, adaptive_pg(ENV, rng=6, **kw))
 
 
 def test_adaptive_record_invariants():
-    rec = adaptive_pg(ENV, 0.0, 1.0, bound="bernstein", empirical_range=True, budget=50_000, rng=1)
+    rec = adaptive_pg(ENV, 0.0, 1.0, error=ErrorModel("bernstein", range="empirical"), budget=50_000, rng=1)
     I = rec.iterations
     assert rec.trajectories == 50_000 and rec.batch_size[0] == 100
     assert rec.theta.shape == (I + 1, 1) and rec.J.shape == (I + 1,)
@@ -49,14 +50,14 @@ def test_adaptive_record_invariants():
 
 def test_two_dimensional_coordinate_descent_moves_one_entry():
     env = LQG.thesis_2d()
-    rec = adaptive_pg(env, np.zeros(4), 1.0, bound="bernstein", empirical_range=True, budget=20_000, rng=0)
+    rec = adaptive_pg(env, np.zeros(4), 1.0, error=ErrorModel("bernstein", range="empirical"), budget=20_000, rng=0)
     moved = np.count_nonzero(np.diff(rec.theta, axis=0), axis=1)
     assert np.all(moved <= 1)
     assert set(rec.coordinate.tolist()) <= {0, 3}  # the diagonal gains dominate from theta = 0
 
 
 def test_metrics():
-    rec = adaptive_pg(ENV, 0.0, 1.0, bound="bernstein", empirical_range=True, budget=30_000, rng=2)
+    rec = adaptive_pg(ENV, 0.0, 1.0, error=ErrorModel("bernstein", range="empirical"), budget=30_000, rng=2)
     assert rec.upsilon_bar() == pytest.approx(np.sum(rec.batch_size * rec.J_hat) / rec.batch_size.sum())
     J = np.array([-3.0, -2.0, -2.5, -2.5, -1.0])
     fake = LearningRecord(np.array([10, 20, 30, 40]), *(np.zeros(4),) * 2, np.zeros((5, 1)), J,
@@ -67,16 +68,17 @@ def test_metrics():
 
 
 def test_vanilla_fixed_step():
-    rec = vanilla_pg(ENV, -0.55, 0.5, batch_size=100, alpha=1e-4, budget=5_000, rng=3)
+    rec = vanilla_pg(ENV, -0.55, 0.5, batch_size=100, step=FixedStep(1e-4), budget=5_000, rng=3)
     assert rec.iterations == 50 and np.all(rec.batch_size == 100)
     np.testing.assert_allclose(np.diff(rec.theta[:, 0]), 1e-4 * rec.grad[:, 0])
 
 
 def test_vanilla_adaptive_steps_in_two_dimensions():
     env = LQG.thesis_2d()
-    kw = dict(batch_size=2000, alpha=None, bound="chebyshev", delta=0.95, budget=20_000, rng=4)
-    scal = vanilla_pg(env, np.zeros(4), 1.0, step="scalar", **kw)
-    coord = vanilla_pg(env, np.zeros(4), 1.0, step="coordinate", **kw)
+    kw = dict(batch_size=2000, budget=20_000, rng=4)
+    error = ErrorModel("chebyshev", 0.95)
+    scal = vanilla_pg(env, np.zeros(4), 1.0, step=SafeStep("scalar", error), **kw)
+    coord = vanilla_pg(env, np.zeros(4), 1.0, step=SafeStep("coordinate", error), **kw)
     assert np.all(np.count_nonzero(np.diff(coord.theta, axis=0), axis=1) <= 1)
     assert np.all(scal.coordinate == -1)
     # Same seed, same first batch: Corollary 4.2.5's ordering of the two steps.
@@ -96,11 +98,11 @@ def test_interrupt_keeps_what_was_computed():
     calls = {"n": 0}
 
     class Flaky(LQG):
-        def gradient_batch(self, *args):
+        def gradient_batch(self, policy, n, rng=None, estimator="gpomdp", baseline=True, score_action="clipped"):
             calls["n"] += 1
             if calls["n"] == 4:
                 raise KeyboardInterrupt
-            return super().gradient_batch(*args)
+            return super().gradient_batch(policy, n, rng, estimator, baseline, score_action)
 
     with pytest.warns(UserWarning, match="interrupted"):
         rec = adaptive_pg(Flaky(), budget=100_000, rng=0)
@@ -131,19 +133,21 @@ def test_progress_callable_reports_each_batch_and_can_cancel(capsys):
 
 @pytest.mark.parametrize(
     "kwargs,name",
-    [({"delta": 1.2}, "delta"), ({"delta": 0.0}, "delta"), ({"sigma": 0.0}, "sigma"),
-     ({"sigma": -1.0}, "sigma"), ({"n_min": 600_000}, "n_min"), ({"budget": 50}, "budget"),
-     ({"theta0": np.nan}, "theta"), ({"theta0": [0.0, 0.0]}, "theta")],
+    [(lambda: {"error": ErrorModel(delta=1.2)}, "delta"), (lambda: {"error": ErrorModel(delta=0.0)}, "delta"),
+     (lambda: {"sigma": 0.0}, "sigma"), (lambda: {"sigma": -1.0}, "sigma"),
+     (lambda: {"batches": Batches(n_min=600_000)}, "n_min"), (lambda: {"budget": 50}, "budget"),
+     (lambda: {"theta0": np.nan}, "theta"), (lambda: {"theta0": [0.0, 0.0]}, "theta")],
 )
 def test_bad_input_names_the_parameter(kwargs, name):
+    # The options check themselves when built, the loop checks the rest: either way, by name.
     with pytest.raises(ValueError, match=f"^{name}"):
-        adaptive_pg(ENV, **{"budget": 1000, **kwargs})
+        adaptive_pg(ENV, **{"budget": 1000, **kwargs()})
 
 
 def test_nan_gradient_raises():
     class Broken(LQG):
-        def gradient_batch(self, *args):
-            samples, returns = super().gradient_batch(*args)
+        def gradient_batch(self, policy, n, rng=None, estimator="gpomdp", baseline=True, score_action="clipped"):
+            samples, returns = super().gradient_batch(policy, n, rng, estimator, baseline, score_action)
             samples[0, 0] = np.nan
             return samples, returns
 
@@ -183,7 +187,7 @@ def test_cli_bad_input_one_line_no_traceback(args, word):
 
 def test_divergence_stops_only_when_asked():
     # b = 0 and a large fixed step: theta runs away until the gradient overflows.
-    kw = dict(batch_size=100, alpha=1e-2, baseline=False, budget=2_000_000, rng=0)
+    kw = dict(batch_size=100, step=FixedStep(1e-2), gradient=Gradient(baseline=False), budget=2_000_000, rng=0)
     with pytest.raises(ValueError, match="^gradient estimate is not finite"):
         vanilla_pg(ENV, -0.55, 1.0, **kw)
     rec = vanilla_pg(ENV, -0.55, 1.0, stop_on_divergence=True, **kw)
@@ -191,32 +195,31 @@ def test_divergence_stops_only_when_asked():
 
 
 def test_target_return_stops_at_the_first_batch_that_reaches_it():
-    kw = dict(batch_size=200, alpha=1e-3, budget=200 * 40, rng=4)
+    kw = dict(batch_size=200, step=FixedStep(1e-3), budget=200 * 40, rng=4)
     full = vanilla_pg(ENV, -0.1, 1.0, **kw)
     target = float(np.sort(full.J_hat)[-5])  # reached, but not at the first batch
     first = int(np.argmax(full.J_hat >= target))
-    rec = vanilla_pg(ENV, -0.1, 1.0, target_return=target, **kw)
+    rec = vanilla_pg(ENV, -0.1, 1.0, target=Target(target), **kw)
     assert rec.reached_target and not full.reached_target
     assert rec.iterations == first + 1
     np.testing.assert_array_equal(rec.J_hat, full.J_hat[: first + 1])
     # The batch that reached the target makes no update: the result is the policy that reached it.
     assert rec.alpha[-1] == 0 and np.array_equal(rec.theta[-1], rec.theta[-2])
     np.testing.assert_array_equal(rec.theta[:-1], full.theta[: first + 1])
-    with pytest.raises(ValueError, match="target_return"):
-        vanilla_pg(ENV, batch_size=100, budget=1000, target_return=float("nan"))
+    with pytest.raises(ValueError, match="^target value"):
+        vanilla_pg(ENV, batch_size=100, budget=1000, target=Target(float("nan")))
 
 
 def test_measured_returns_hook_sets_J_hat():
-    class Undiscounted(LQG):
-        """An LQG reporting undiscounted returns, through the hook the cart-pole uses."""
-
-        gradient_batch = None  # take the simulate + gradient_samples path
+    class Undiscounted(_Simulated, MeasuredReturns):
+        """An LQG reporting undiscounted returns, through the hook the cart-pole uses (and
+        without the fused path, so that the loop simulates the batch)."""
 
         def measured_returns(self, batch):
             return batch.rewards.sum(axis=1)
 
     env = Undiscounted(dim=1, gamma=0.9, horizon=20)
-    rec = vanilla_pg(env, -0.3, 1.0, batch_size=300, alpha=1e-3, budget=600, rng=1)
+    rec = vanilla_pg(env, -0.3, 1.0, batch_size=300, step=FixedStep(1e-3), budget=600, rng=1)
     batch = env.simulate(LinearGaussianPolicy(np.array([[-0.3]]), 1.0), 300, np.random.default_rng(1))
     assert rec.J_hat[0] == pytest.approx(batch.rewards.sum(axis=1).mean(), rel=1e-12)
     assert rec.J_hat[0] != pytest.approx(batch.discounted_returns().mean(), rel=1e-3)
@@ -226,6 +229,17 @@ def test_measured_returns_hook_sets_J_hat():
 ENV2 = LQG.thesis_2d(gamma=0.9)
 
 
+class _Simulated:
+    """An LQG without its fused path (it declares none of safepg.tasks' hooks): the loops simulate
+    the batch and apply gradient_samples to it."""
+
+    def __init__(self, **fields):
+        self._lqg = LQG(**fields)
+
+    def __getattr__(self, name):
+        return getattr(self.__dict__["_lqg"], name)
+
+
 def _first_batch(env, theta0, n, seed):
     """The first batch an adaptive run with ``rng=seed`` draws: samples and returns."""
     pol = LinearGaussianPolicy(np.asarray(theta0, float).reshape(env.dim, env.dim), 1.0)
@@ -233,24 +247,24 @@ def _first_batch(env, theta0, n, seed):
 
 
 def test_n_first_sets_only_the_first_batch():
-    kw = dict(bound="bernstein", empirical_range=True, budget=20_000)
-    rec = adaptive_pg(ENV, n_first=1000, n_min=10, rng=np.random.default_rng(3), **kw)
+    kw = dict(error=ErrorModel("bernstein", range="empirical"), budget=20_000)
+    rec = adaptive_pg(ENV, batches=Batches(n_min=10, first=1000), rng=np.random.default_rng(3), **kw)
     assert rec.batch_size[0] == 1000 and rec.config["n_first"] == 1000
     # The rest follows N* clipped to [n_min, n_max]; without n_first the first batch is n_min.
     assert 1000 not in rec.batch_size[1:-1]
-    default = adaptive_pg(ENV, n_min=10, rng=3, **kw)
+    default = adaptive_pg(ENV, batches=Batches(n_min=10), rng=3, **kw)
     assert default.batch_size[0] == 10 and "n_first" not in default.config
-    with pytest.raises(ValueError, match="^n_first "):
-        adaptive_pg(ENV, n_first=1, budget=1000)
+    with pytest.raises(ValueError, match="^first "):
+        Batches(first=1)
     with pytest.raises(ValueError, match="^budget "):
-        adaptive_pg(ENV, n_first=2000, budget=1000)
+        adaptive_pg(ENV, batches=Batches(first=2000), budget=1000)
 
 
 def test_statistics_max_uses_the_largest_variance_and_range_over_components():
     from safepg.bounds import bernstein
 
-    kw = dict(bound="bernstein", empirical_range=True, budget=300, n_first=300)
-    rec = adaptive_pg(ENV2, np.zeros(4), statistics="max", rng=np.random.default_rng(8), **kw)
+    kw = dict(error=ErrorModel("bernstein", range="empirical"), budget=300, batches=Batches(first=300))
+    rec = adaptive_pg(ENV2, np.zeros(4), departures=Departures(maxima=True), rng=np.random.default_rng(8), **kw)
     samples, _ = _first_batch(ENV2, np.zeros(4), 300, 8)
     k = int(rec.coordinate[0])
     var, rng_ = np.var(samples, axis=0, ddof=1), np.ptp(samples, axis=0)
@@ -258,19 +272,16 @@ def test_statistics_max_uses_the_largest_variance_and_range_over_components():
     own = adaptive_pg(ENV2, np.zeros(4), rng=np.random.default_rng(8), **kw)
     assert own.eps[0] == pytest.approx(bernstein(0.95, var[k], rng_[k]).eps(300), rel=1e-12)
     assert rec.eps[0] > own.eps[0]  # the maxima are the more conservative choice here
-    with pytest.raises(ValueError, match="^statistics "):
-        adaptive_pg(ENV, statistics="mean", budget=1000)
+    with pytest.raises(ValueError, match="^maxima "):
+        Departures(maxima="max")
 
 
 def test_constants_batch_measures_R_and_M_phi_on_each_batch():
-    class Simulated(LQG):
-        """The 1-D LQG without its fused path: the loop measures the maxima on the simulated batch."""
-
-        gradient_batch = None
-
-    env = Simulated(dim=1, gamma=0.9, horizon=20)
-    kw = dict(bound="bernstein", empirical_range=True, budget=400, n_first=400)
-    rec = adaptive_pg(env, -0.5, 0.1, constants="batch", step_when_unsafe=True, rng=np.random.default_rng(2), **kw)
+    # The 1-D LQG without its fused path: the loop measures the maxima on the simulated batch.
+    env = _Simulated(dim=1, gamma=0.9, horizon=20)
+    kw = dict(error=ErrorModel("bernstein", range="empirical"), budget=400, batches=Batches(first=400))
+    rec = adaptive_pg(env, -0.5, 0.1, departures=Departures(batch_constants=True, unguarded_step=True),
+                      rng=np.random.default_rng(2), **kw)
     batch = env.simulate(LinearGaussianPolicy(np.array([[-0.5]]), 0.1), 400, np.random.default_rng(2))
     R, M = np.abs(batch.rewards).max(), np.abs(batch.features).max()
     assert R < env.reward_bound and M < env.feature_bound  # measured values are below the bounds ...
@@ -280,14 +291,14 @@ def test_constants_batch_measures_R_and_M_phi_on_each_batch():
     assert rec.alpha[0] == pytest.approx(coordinate_step(g, rec.eps[0], c, guarded=False), rel=1e-12)
     # ... so the penalty is smaller and the step larger than with the bounds (config["c"] keeps the latter).
     assert rec.config["c"] == penalty_constant(bounds) > c
-    with pytest.raises(ValueError, match="^constants "):
-        adaptive_pg(ENV, constants="measured", budget=1000)
+    with pytest.raises(ValueError, match="^batch_constants "):
+        Departures(batch_constants="batch")
 
 
 def test_step_when_unsafe_moves_where_the_algorithm_stops():
     # Chebyshev at N = 100 from theta = 0: eps exceeds |g| on the first batch.
     kw = dict(budget=100, rng=0)
-    guarded, unguarded = adaptive_pg(ENV, **kw), adaptive_pg(ENV, step_when_unsafe=True, **kw)
+    guarded, unguarded = adaptive_pg(ENV, **kw), adaptive_pg(ENV, departures=Departures(unguarded_step=True), **kw)
     assert not guarded.safe[0] and not unguarded.safe[0]
     assert guarded.alpha[0] == 0.0 and unguarded.alpha[0] > 0.0
     g, eps = abs(unguarded.grad[0, 0]), unguarded.eps[0]
@@ -298,8 +309,9 @@ def test_step_when_unsafe_moves_where_the_algorithm_stops():
 
 
 def test_update_at_target_updates_before_stopping():
-    kw = dict(batch_size=200, alpha=1e-3, budget=200 * 40, rng=4, target_return=-1e9)
-    kept, updated = vanilla_pg(ENV, -0.1, 1.0, **kw), vanilla_pg(ENV, -0.1, 1.0, update_at_target=True, **kw)
+    kw = dict(batch_size=200, step=FixedStep(1e-3), budget=200 * 40, rng=4)
+    kept = vanilla_pg(ENV, -0.1, 1.0, target=Target(-1e9), **kw)
+    updated = vanilla_pg(ENV, -0.1, 1.0, target=Target(-1e9, update=True), **kw)
     assert kept.reached_target and updated.reached_target and kept.iterations == updated.iterations == 1
     assert kept.theta[-1] == kept.theta[0] and updated.theta[-1] != updated.theta[0]
     np.testing.assert_allclose(updated.theta[-1] - updated.theta[0], 1e-3 * updated.grad[0])
@@ -307,23 +319,28 @@ def test_update_at_target_updates_before_stopping():
 
 
 def test_run_config_passes_the_options_and_keeps_unset_keys():
+    from safepg.options import Adaptive, Vanilla
     from safepg.runner import RESULTS_VERSION, RunConfig
 
     plain = RunConfig("a", budget=2000)
-    # The key of a config without the options is the one it had before they existed: the
-    # hash of the fields the config had then, and the results version.
-    options = ("n_first", "constants", "statistics", "step_when_unsafe", "update_at_target")
-    before = {k: v for k, v in asdict(plain).items()
-              if v is not None and k not in ("name", "warm_start_key", "env_factory", *options)}
+    # The key of a config without the departures is the one it had before they existed: the
+    # hash of the flat fields the config had then, and the results version.
+    before = {"algorithm": "adaptive", "env": "lqg1d", "theta0": [0.0], "sigma": 1.0, "estimator": "gpomdp",
+              "baseline": True, "bound": "chebyshev", "delta": 0.95, "empirical_range": False, "n_min": 100,
+              "n_max": 500_000, "step": "scalar", "budget": 2000, "score_action": "clipped"}
+    assert plain.fields() == before
     blob = json.dumps([before, RESULTS_VERSION], sort_keys=True)
     assert plain.key() == hashlib.sha256(blob.encode()).hexdigest()[:16]
-    opts = RunConfig("a", budget=2000, n_first=500, constants="batch", statistics="max", step_when_unsafe=True)
-    assert len({plain.key(), opts.key(), RunConfig("a", budget=2000, n_first=100).key()}) == 3
+    opts = RunConfig("a", budget=2000, method=Adaptive(batches=Batches(first=500), departures=Departures(
+        batch_constants=True, maxima=True, unguarded_step=True)))
+    first100 = RunConfig("a", budget=2000, method=Adaptive(batches=Batches(first=100)))
+    assert len({plain.key(), opts.key(), first100.key()}) == 3
     rec = opts.run(0)
     assert rec.batch_size[0] == 500
     assert {k: rec.config[k] for k in ("n_first", "constants", "statistics", "step_when_unsafe")} == {
         "n_first": 500, "constants": "batch", "statistics": "max", "step_when_unsafe": True}
-    with pytest.raises(ValueError, match="options of adaptive runs"):
-        RunConfig("v", "vanilla", batch_size=100, alpha=1e-3, budget=1000, n_first=200).run(0)
-    with pytest.raises(ValueError, match="^update_at_target "):
-        RunConfig("a", budget=1000, update_at_target=True).run(0)
+    # An option of the other method cannot be given at all; a method must be one of the two.
+    with pytest.raises(TypeError):
+        Vanilla(100, FixedStep(1e-3), batches=Batches(first=200))  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match="^method "):
+        RunConfig("a", budget=1000, method="vanilla")  # type: ignore[arg-type]

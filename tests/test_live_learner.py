@@ -40,7 +40,9 @@ def fake_record(batch_sizes: list[int], seed: int) -> LearningRecord:
 def stored():
     exp = get_experiment("table-5.2")
     good = exp.config(t52_name("gpomdp", "bernstein", True, 0.95))
-    other = replace(exp.config(t52_name("gpomdp", "hoeffding", False, 0.95)), name="range", theoretical_range=1280.0)
+    hoeffding = exp.config(t52_name("gpomdp", "hoeffding", False, 0.95))
+    other = replace(hoeffding, name="range",
+                    method=replace(hoeffding.method, error=replace(hoeffding.method.error, range=1280.0)))
     sizes = [100] + [50_000] * 100  # 5.0001e6 trajectories: past the largest budget
     records = {good.name: [fake_record(sizes, 0), fake_record([100] + [70_000] * 60, 1)],
                other.name: [fake_record(sizes, 2)]}

@@ -11,6 +11,7 @@ import pytest
 from safepg.learning import LearningRecord
 from safepg.thesis import authors as A
 from safepg.thesis import experiments as ex
+from safepg.thesis import report as rp
 
 
 def _record_of(run: A.AuthorsRun, n: int) -> LearningRecord:
@@ -28,12 +29,13 @@ def _record_of(run: A.AuthorsRun, n: int) -> LearningRecord:
 def their_records():
     runs = A.table51_runs()
     exp = ex.get_experiment("table-5.1-authors")
-    return {c.name: [_record_of(runs[(c.sigma, c.batch_size, c.alpha)], c.batch_size)] for c in exp.configs}
+    return {c.name: [_record_of(runs[(c.sigma, c.method.batch_size, c.method.step.alpha)], c.method.batch_size)]
+            for c in exp.configs}
 
 
 def test_table_5_1_authors_counting_on_their_files_gives_the_print(their_records):
     exp = ex.get_experiment("table-5.1-authors")
-    rows = {r["name"]: r for r in ex.report(exp, their_records)["configs"]}
+    rows = {r["name"]: r for r in rp.report(exp, their_records)["configs"]}
     off = {}
     for c in exp.configs:
         ours = rows[c.name]["improvement_ratio"]["mean"]
@@ -49,7 +51,7 @@ def test_the_thesis_text_counting_does_not_give_the_print(their_records):
     the N = 10^4 cells become k/100 and leave the print."""
     exp = ex.get_experiment("table-5.1")
     named = {c.name: their_records[c.name] for c in exp.configs}
-    rows = {r["name"]: r for r in ex.report(replace(exp, name="check"), named)["configs"]}
+    rows = {r["name"]: r for r in rp.report(replace(exp, name="check"), named)["configs"]}
     cell = rows["sigma=0.5-N=10000-alpha=1e-03"]
     assert cell["improvement_ratio"]["mean"] == 96 / 100  # 95 increases, and the +inf after the last update
     assert round(cell["improvement_ratio"]["mean"], 4) != exp.thesis[cell["name"]]["improvement_ratio"]

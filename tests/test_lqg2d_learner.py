@@ -12,13 +12,15 @@ import numpy as np
 import pytest
 from ch5_node import NODE, run_page
 
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import learn
+from safepg.options import Departures, ErrorModel, FixedStep, SafeStep, Vanilla
 from safepg.thesis.experiments import get_experiment
 from safepg.thesis.explorers.ch5_live import learner_source, record_c, record_trace
+from safepg.thesis.explorers.js_tasks import learner_options
 from safepg.thesis.explorers.lqg2d_learner import (
-    AUTHORS_2D,
     adaptive_configs,
     adaptive_result,
+    authors_2d,
     lqg2d_adaptive_explorer,
     lqg2d_env,
     lqg2d_steps_explorer,
@@ -27,9 +29,6 @@ from safepg.thesis.explorers.lqg2d_learner import (
 )
 
 needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
-#: What the page asks of the engine, in its names, for safepg's keyword arguments.
-CAMEL = {"batch_size": "batchSize", "empirical_range": "empiricalRange", "stop_on_divergence": "stopOnDivergence",
-         "n_min": "nMin", "n_max": "nMax", "n_first": "nFirst", "step_when_unsafe": "stepWhenUnsafe"}
 
 
 @pytest.fixture(scope="module")
@@ -54,19 +53,18 @@ def test_pages_are_self_contained(steps, adaptive):
 
 
 def test_steps_defaults_are_the_registrys(steps):
-    """The defaults are figures-5.5-5.6's settings; each run is vanilla_pg with alpha=None and its step."""
+    """The defaults are figures-5.5-5.6's settings; each run is vanilla_pg with the SafeStep of its kind."""
     exp = get_experiment("figures-5.5-5.6")
     p = steps.defaults()
     runs = steps_configs(p)
-    for name, kw in runs.items():
+    assert list(runs) == ["scalar", "coordinate"]
+    for name, method in runs.items():
         cfg = exp.config(name)
-        assert kw["step"] == cfg.step == name and kw["alpha"] is None and cfg.alpha is None
-        assert (kw["batch_size"], kw["bound"], kw["empirical_range"], kw["delta"]) == \
-            (cfg.batch_size, cfg.bound, cfg.empirical_range, cfg.delta)
+        assert isinstance(method.step, SafeStep) and method.step.kind == name
+        assert method == cfg.method  # N, bound, delta, range: the registry's
         assert tuple(steps.data["theta0"]) == cfg.theta0 and p["sigma"] == cfg.sigma
     moved = steps_configs({**p, "bound": "bernstein-er", "n": "500", "delta": 0.5, "budget": "30000"})["scalar"]
-    assert (moved["bound"], moved["empirical_range"], moved["batch_size"], moved["delta"], moved["budget"]) == \
-        ("bernstein", True, 500, 0.5, 30_000)
+    assert moved == Vanilla(500, SafeStep("scalar", ErrorModel("bernstein", 0.5, "empirical")))
 
 
 def test_adaptive_defaults_and_the_authors_switch(adaptive):
@@ -75,18 +73,17 @@ def test_adaptive_defaults_and_the_authors_switch(adaptive):
     p = adaptive.defaults()
     assert p["authors"] is False
     runs = adaptive_configs(p)
-    a = t53.config("adaptive")
-    assert (runs["adaptive"]["bound"], runs["adaptive"]["empirical_range"], runs["adaptive"]["delta"],
-            runs["adaptive"]["n_min"], runs["adaptive"]["n_max"]) == (a.bound, a.empirical_range, a.delta, a.n_min,
-                                                                      a.n_max)
-    assert not {"statistics", "step_when_unsafe", "n_first"} & set(runs["adaptive"])  # safepg's defaults
+    assert runs["adaptive"] == t53.config("adaptive").method  # bound, delta, N_min, N_max
+    assert runs["adaptive"].departures == Departures() and runs["adaptive"].batches.first is None  # safepg's defaults
     for name in ("N=1000", "N=100"):
-        c = t53.config(name)
-        assert (runs[name]["batch_size"], runs[name]["alpha"]) == (c.batch_size, c.alpha)
-    on = adaptive_configs({**p, "authors": True, "n_max": str(AUTHORS_2D["n_max"])})["adaptive"]
-    assert (on["statistics"], on["step_when_unsafe"], on["n_max"]) == \
-        (authors.statistics, authors.step_when_unsafe, authors.n_max)
-    assert on["n_first"] == AUTHORS_2D["n_first"] == 100  # their 2-D script's hard-coded first batch
+        assert runs[name] == t53.config(name).method
+    on = adaptive_configs({**p, "authors": True, "n_max": str(authors_2d().batches.n_max)})["adaptive"]
+    assert on == authors_2d()
+    a = authors.method
+    assert (on.error, on.departures, on.batches.n_min, on.batches.n_max) == (
+        a.error, a.departures, a.batches.n_min, a.batches.n_max)
+    assert on.departures.changed() == ("maxima", "unguarded_step") and on.batches.n_max == 100_000
+    assert on.batches.first == 100  # their 2-D script's hard-coded first batch (= N_min: the same run)
 
 
 @needs_node
@@ -108,25 +105,27 @@ def test_page_configs_are_the_python_settings(steps, adaptive):
             py = fn(p)
             js = {r["name"]: r["cfg"] for r in got["configs"]["runs"]}
             assert list(js) == list(py)
-            for name, kw in py.items():
+            for name, method in py.items():
                 cfg = js[name]
                 assert cfg["sigma"] == p["sigma"] and cfg["seed"] == round(p["seed"])
-                assert cfg["theta0"] == [0.0] * 4
-                for k, v in kw.items():
-                    assert cfg[CAMEL.get(k, k)] == v, (m, name, k)
+                assert cfg["theta0"] == [0.0] * 4 and cfg["budget"] == int(p["budget"])
+                fixed_step = isinstance(method, Vanilla) and isinstance(method.step, FixedStep)
+                if isinstance(method, Vanilla):
+                    assert cfg["stopOnDivergence"] is True  # learn() stops a diverging vanilla run
+                for k, v in learner_options(method).items():
+                    if k not in cfg:  # the page leaves out what is at the learner's default
+                        assert (k, v) in {("theoreticalRange", None), ("constants", "bounds")}, (m, name, k)
+                    elif not (fixed_step and k in ("bound", "empiricalRange", "delta")):  # no bound in a fixed step
+                        assert cfg[k] == v, (m, name, k)
     assert out_a[-2]["linked"] == {"n_max": "100000"} and out_a[-1]["linked"] == {"n_max": "500000"}
 
 
 def small_traces(p, budget=3000):
     env, theta0 = lqg2d_env(), np.zeros(4)
     traces = {}
-    for k, (name, kw) in enumerate(adaptive_configs({**p, "budget": str(budget)}).items()):
-        kw = {**kw, "rng": np.random.default_rng([0, k])}
-        if name == "adaptive":
-            rec = adaptive_pg(env, theta0, float(p["sigma"]), **kw)
-            traces[name] = record_trace(rec, record_c(rec))
-        else:
-            traces[name] = record_trace(vanilla_pg(env, theta0, float(p["sigma"]), **kw))
+    for k, (name, method) in enumerate(adaptive_configs({**p, "budget": str(budget)}).items()):
+        rec = learn(env, method, theta0, float(p["sigma"]), budget=budget, rng=np.random.default_rng([0, k]))
+        traces[name] = record_trace(rec, record_c(rec)) if name == "adaptive" else record_trace(rec)
     return traces
 
 
@@ -137,8 +136,8 @@ def test_page_draws_what_the_twin_draws_from_the_same_runs(steps, adaptive):
     traces = small_traces(p)
     env = lqg2d_env()
     ts = {}
-    for k, (name, kw) in enumerate(steps_configs({**steps.defaults(), "budget": "6000"}).items()):
-        ts[name] = record_trace(vanilla_pg(env, np.zeros(4), 1.0, rng=np.random.default_rng([0, k]), **kw))
+    for k, (name, method) in enumerate(steps_configs({**steps.defaults(), "budget": "6000"}).items()):
+        ts[name] = record_trace(learn(env, method, np.zeros(4), 1.0, budget=6000, rng=np.random.default_rng([0, k])))
     js_a, = run_page("lqg2d_page.js", "safepgLqg2dAdaptive", [{"p": p, "data": adaptive.data, "traces": traces}])
     js_s, = run_page("lqg2d_page.js", "safepgLqg2dSteps", [{"p": steps.defaults(), "data": steps.data,
                                                              "traces": ts}])

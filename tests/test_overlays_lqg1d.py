@@ -12,6 +12,7 @@ import pytest
 
 from safepg.envs.lqg import LQG
 from safepg.learning import vanilla_pg
+from safepg.options import FixedStep
 from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis import overlays as O
@@ -25,7 +26,8 @@ def short_runs():
     out = {}
     for sigma, n, alpha in O.T51_OVERLAY_CELLS:
         out[f"sigma={sigma}-N={n}-alpha={alpha:.0e}"] = [
-            vanilla_pg(LQG.thesis_1d(), np.array([-0.575853]), sigma, batch_size=n, alpha=alpha, budget=5 * n, rng=s)
+            vanilla_pg(LQG.thesis_1d(), np.array([-0.575853]), sigma, batch_size=n, step=FixedStep(alpha), budget=5 * n,
+                       rng=s)
             for s in (1, 2)]
     return out
 
@@ -86,12 +88,14 @@ def test_table51_overlay_refuses_missing_runs(short_runs):
 def test_figures_5_1_5_2_overlay_carry_ours_and_the_authors_curves(figure):
     exp = get_experiment("table-5.2")
     if figure == "5.1":
-        configs = [c for c in exp.configs if c.bound == "chebyshev" and c.delta in (0.95, 0.5)]
+        configs = [c for c in exp.configs if (c.method.error.bound, c.method.error.delta) in (
+            ("chebyshev", 0.95), ("chebyshev", 0.5))]
     else:
-        configs = [c for c in exp.configs if c.estimator == "gpomdp" and c.delta == 0.95][:2]
+        configs = [c for c in exp.configs
+                   if c.method.gradient.estimator == "gpomdp" and c.method.error.delta == 0.95][:2]
     # Short stand-in runs under the configs' names: only their J over trajectories is drawn.
-    records = {c.name: [vanilla_pg(LQG.thesis_1d(), np.array([-0.2 - 0.1 * i]), 1.0, batch_size=1000, alpha=1e-4,
-                                   budget=8000, rng=i) for i in range(3)] for c in configs}
+    records = {c.name: [vanilla_pg(LQG.thesis_1d(), np.array([-0.2 - 0.1 * i]), 1.0, batch_size=1000,
+                                   step=FixedStep(1e-4), budget=8000, rng=i) for i in range(3)] for c in configs}
     draw = O.figure_5_1_overlay if figure == "5.1" else O.figure_5_2_overlay
     fig = draw(records, configs)
     try:
@@ -99,8 +103,10 @@ def test_figures_5_1_5_2_overlay_carry_ours_and_the_authors_curves(figure):
         colours = [ln for ln in lines if ln.get_color() != "black"]
         theirs = [ln for ln in lines if ln.get_color() == "black"]
         assert len(colours) == len(theirs) == len(configs)
-        for c, ours_line, their_line in zip(sorted(configs, key=lambda c: c.estimator != "gpomdp"), colours, theirs):
-            curve = authors.figure51_52_curves()[(c.estimator, c.bound, c.empirical_range, c.delta)]
+        by_estimator = sorted(configs, key=lambda c: c.method.gradient.estimator != "gpomdp")
+        for c, ours_line, their_line in zip(by_estimator, colours, theirs):
+            f = c.fields()
+            curve = authors.figure51_52_curves()[(f["estimator"], f["bound"], f["empirical_range"], f["delta"])]
             assert np.array_equal(their_line.get_ydata(), curve["J"])
             grid = curve["trajectories"].astype(np.int64)
             assert np.array_equal(ours_line.get_xdata(), grid)

@@ -15,8 +15,9 @@ from safepg.envs.lqg import LQG
 from safepg.thesis import prefetch, safety_store, table51_sweep
 from safepg.thesis.budget import CHAPTER_EXPERIMENTS
 from safepg.thesis.cartpole_sweep import baseline_experiments
-from safepg.thesis.experiments import EXPERIMENTS, SWEEP_SEEDS, get_experiment
+from safepg.thesis.experiments import EXPERIMENTS, get_experiment
 from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS
+from safepg.thesis.sweep_settings import SWEEP_SEEDS
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 

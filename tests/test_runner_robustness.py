@@ -17,6 +17,7 @@ import pytest
 from safepg import runner, store
 from safepg.cli import main
 from safepg.learning import LearningRecord
+from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
 
 #: The campaign the kill and concurrency tests run from the command line: 2 configs x 4 seeds,
@@ -64,7 +65,7 @@ def uninterrupted(tmp_path_factory) -> Path:
     """The campaign run once without interruption (in this process), in its own folder."""
     results = tmp_path_factory.mktemp("uninterrupted")
     exp = ex.scaled(ex.get_experiment(CAMPAIGN[0]), seeds=int(CAMPAIGN[2]), budget=int(CAMPAIGN[4]))
-    ex.run_experiment(exp, jobs=1, root=results, progress=False)
+    es.run_experiment(exp, jobs=1, root=results, progress=False)
     return results
 
 
@@ -90,7 +91,7 @@ def test_dask_cluster_gives_the_serial_records_and_the_client_stores_them(tmp_pa
 
     e = ex.get_experiment("table-5.2")
     exp = ex.scaled(replace(e, configs=e.configs[:2]), seeds=2, budget=10_000)
-    serial = ex.run_experiment(exp, jobs=1, root=tmp_path / "serial", progress=False)
+    serial = es.run_experiment(exp, jobs=1, root=tmp_path / "serial", progress=False)
 
     saved = []  # save_atomic as seen by this (the client) process
     save = store.save_atomic
@@ -99,20 +100,22 @@ def test_dask_cluster_gives_the_serial_records_and_the_client_stores_them(tmp_pa
           Client(cluster) as client):
         worker_pids = set(client.run(os.getpid).values())
         with get_task_stream(client) as tasks, joblib.parallel_config(backend="dask"):
-            remote = ex.run_experiment(exp, root=tmp_path / "dask", progress=False)
+            remote = es.run_experiment(exp, root=tmp_path / "dask", progress=False)
     assert len(worker_pids) == 2 and os.getpid() not in worker_pids
     assert tasks.data and all("_compute_task" in t["key"] for t in tasks.data)  # the runs ran on the workers
     assert sorted(saved) == _runs(tmp_path / "dask") and len(saved) == 4  # ... and the client wrote them
     assert_same_records(serial, remote)
-    assert_same_records(serial, ex.load_experiment(exp, root=tmp_path / "dask"))
+    assert_same_records(serial, es.load_experiment(exp, root=tmp_path / "dask"))
 
 
 def test_warm_start_is_resolved_before_dispatch(tmp_path, monkeypatch):
     """A table-5.4 worker gets its starting policy with the task and never reads the store."""
     base = ex.get_experiment("cartpole-baseline")
-    cheap = ex.scaled(replace(base, configs=(replace(base.configs[0], target_return=None),)), seeds=1, budget=8000)
+    b0 = base.configs[0]
+    cheap = ex.scaled(replace(base, configs=(replace(b0, method=replace(b0.method, target=None)),)), seeds=1,
+                      budget=8000)
     monkeypatch.setitem(ex.EXPERIMENTS, "cartpole-baseline", cheap)
-    baseline = ex.run_experiment(cheap, jobs=1, root=tmp_path, progress=False)["baseline"][0]
+    baseline = es.run_experiment(cheap, jobs=1, root=tmp_path, progress=False)["baseline"][0]
 
     def no_store(*args, **kwargs):
         raise AssertionError("a run read the store")
@@ -128,7 +131,7 @@ def test_warm_start_is_resolved_before_dispatch(tmp_path, monkeypatch):
 
     monkeypatch.setattr(runner, "_compute", compute_without_store)
     t54 = ex.scaled(ex.get_experiment("table-5.4"), seeds=1, budget=8000)
-    recs = ex.run_experiment(t54, jobs=1, root=tmp_path, progress=False)
+    recs = es.run_experiment(t54, jobs=1, root=tmp_path, progress=False)
     for name in ("adaptive", "N=4000"):
         np.testing.assert_array_equal(recs[name][0].theta[0], baseline.theta_final)
     with pytest.raises(ValueError, match="^theta0 must be given for the warm-started config"):
@@ -141,7 +144,7 @@ def test_longest_runs_are_dispatched_first(tmp_path, monkeypatch):
     order = []
     compute = runner._compute
     monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.budget), compute(c, *a))[1])
-    ex.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
+    es.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
     assert order == [3000, 2000, 1000]
 
 
@@ -151,7 +154,7 @@ def test_ctrl_c_inside_a_run_stops_the_campaign(tmp_path, monkeypatch):
     compute = runner._compute
     monkeypatch.setattr(runner, "_compute", lambda *a: replace(compute(*a), interrupted=True))
     with pytest.raises(KeyboardInterrupt):
-        ex.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
+        es.run_experiment(exp, jobs=1, root=tmp_path, progress=False)
     assert _runs(tmp_path) == [] and _temps(tmp_path) == []
 
 
@@ -207,7 +210,7 @@ def test_two_runners_at_once_on_one_folder(tmp_path, uninterrupted, capsys, monk
         assert proc.wait(timeout=300) == 0, proc.stderr.read()
     assert _temps(tmp_path) == [] and len(_runs(tmp_path)) == RUNS
     exp = ex.scaled(ex.get_experiment(CAMPAIGN[0]), seeds=int(CAMPAIGN[2]), budget=int(CAMPAIGN[4]))
-    assert_same_records(ex.load_experiment(exp, root=tmp_path), ex.load_experiment(exp, root=uninterrupted))
+    assert_same_records(es.load_experiment(exp, root=tmp_path), es.load_experiment(exp, root=uninterrupted))
     assert _report(tmp_path, capsys, monkeypatch) == _report(uninterrupted, capsys, monkeypatch)
 
 
@@ -304,7 +307,7 @@ def test_bad_counts_name_the_parameter(tmp_path, monkeypatch, capsys, argv, mess
 
 def test_python_api_refuses_zero_jobs_and_seeds(tmp_path):
     with pytest.raises(ValueError, match="^jobs must be"):
-        ex.run_experiment("table-5.1", seeds=1, budget=1000, jobs=0, root=tmp_path, progress=False)
+        es.run_experiment("table-5.1", seeds=1, budget=1000, jobs=0, root=tmp_path, progress=False)
     for kw in ({"seeds": 0}, {"budget": -5}, {"seeds": 1.0}, {"budget": True}):
         with pytest.raises(ValueError, match=f"^{next(iter(kw))} must be a positive integer"):
             ex.scaled(ex.get_experiment("table-5.1"), **kw)
@@ -337,7 +340,7 @@ def test_report_with_nothing_stored_says_which_run_to_type(tmp_path, monkeypatch
     # Partly stored: the report is printed, with a note on what is missing.
     exp = ex.scaled(ex.get_experiment("table-5.1"), seeds=1, budget=10_000)
     exp_one = replace(exp, configs=exp.configs[:1])
-    ex.run_experiment(exp_one, jobs=1, progress=False)
+    es.run_experiment(exp_one, jobs=1, progress=False)
     code, out, err = _cli(capsys, "report", "table-5.1", "--seeds", "1", "--budget", "1e4", "--json")
     assert code == 0 and json.loads(out)["configs"][0]["seeds"] == 1
     assert "1 of 24 runs of table-5.1 stored" in err
@@ -360,5 +363,5 @@ def test_equal_budgets_put_the_smallest_fixed_batches_first(tmp_path, monkeypatc
     order = []
     compute = runner._compute
     monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.name), compute(c, *a))[1])
-    ex.run_experiment(e, jobs=1, root=tmp_path, progress=False)
+    es.run_experiment(e, jobs=1, root=tmp_path, progress=False)
     assert order == ["N=100", "N=1000", "adaptive"]

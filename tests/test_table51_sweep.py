@@ -154,10 +154,11 @@ def test_run_cell_is_seeded_by_variant_start_and_cell():
 @pytest.mark.parametrize("baseline,flag", [("optimal", True), ("none", False)])
 def test_fixed_step_run_is_the_library_vanilla_loop(baseline, flag):
     from safepg.learning import vanilla_pg
+    from safepg.options import FixedStep, Gradient
 
     ours = ts.fixed_step_run(ENV, -0.575, 1.0, 500, 1e-3, 10_000, np.random.default_rng(4), baseline)
-    lib = vanilla_pg(ENV, -0.575, 1.0, batch_size=500, alpha=1e-3, budget=10_000, baseline=flag,
-                     rng=np.random.default_rng(4))
+    lib = vanilla_pg(ENV, -0.575, 1.0, batch_size=500, step=FixedStep(1e-3), budget=10_000,
+                     gradient=Gradient(baseline=flag), rng=np.random.default_rng(4))
     np.testing.assert_allclose(ours, lib.theta[:, 0], rtol=0, atol=1e-12)
     assert ts.improvement_ratio(ts.closed_form_j(ours, 1.0)) == lib.improvement_ratio()
 

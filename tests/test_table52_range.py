@@ -15,10 +15,12 @@ THEORETICAL_ROWS = {"gpomdp-hoeffding-delta=0.95", "gpomdp-bernstein-delta=0.95"
 
 def test_table_5_2_uses_the_reconstructed_range_on_exactly_the_theoretical_range_rows():
     exp = get_experiment("table-5.2")
-    ranged = {c.name: c.theoretical_range for c in exp.configs if c.theoretical_range is not None}
+    ranged = {c.name: c.method.error.range for c in exp.configs if not isinstance(c.method.error.range, str)}
     assert ranged == {name: 1280.0 for name in THEORETICAL_ROWS}
     # Chebyshev has no range and the empirical-range rows measure theirs.
-    assert all(c.bound != "chebyshev" and not c.empirical_range for c in exp.configs if c.name in ranged)
+    assert all(c.method.error.bound != "chebyshev" for c in exp.configs if c.name in ranged)
+    assert {c.method.error.range for c in exp.configs if c.name not in ranged} == {"lemma", "empirical"}
+    assert all(c.fields()["theoretical_range"] == 1280.0 for c in exp.configs if c.name in ranged)
 
 
 def test_reconstructed_range_is_four_h_mphi_abar_r_over_sigma_squared():
@@ -32,11 +34,12 @@ def test_lemma_range_variant_runs_the_same_rows_with_the_lemma_range_6400():
     k = TaskConstants.from_task(LQG.thesis_1d(), 1.0)
     for c in lemma.configs:
         base = t52.config(c.name.removesuffix("-lemma-range"))
-        assert c.theoretical_range is None  # the library default: Lemma 4.3.3
+        assert c.method.error.range == "lemma" and "theoretical_range" not in c.fields()  # Lemma 4.3.3
         assert lemma.thesis[c.name] == t52.thesis[base.name]
         assert c.key() != base.key()  # a different setting, so a different stored run
-        d = error_bound("hoeffding", np.zeros(4), c.delta, k, c.estimator, False, c.theoretical_range).d
-        assert d == pytest.approx(6400 * math.sqrt(math.log(2 / c.delta) / 2), rel=1e-12)
+        delta = c.method.error.delta
+        d = error_bound("hoeffding", np.zeros(4), delta, k, c.method.gradient.estimator, c.method.error.range).d
+        assert d == pytest.approx(6400 * math.sqrt(math.log(2 / delta) / 2), rel=1e-12)
 
 
 def test_old_range_experiment_name_is_gone():
