@@ -25,18 +25,7 @@ from safepg.meta import (
     penalty_constant,
     scalar_step,
 )
-from safepg.options import (
-    Adaptive,
-    Batches,
-    Departures,
-    ErrorModel,
-    FixedStep,
-    Gradient,
-    Method,
-    SafeStep,
-    Target,
-    Vanilla,
-)
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.record import CHECKPOINTS, LearningRecord, RecordFileError
 from safepg.rng import RNGLike, as_generator
@@ -397,7 +386,7 @@ def vanilla_pg(
                   stop_on_divergence, target)
 
 
-def learn(task: Task, method: Method, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
+def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
           budget: int, rng: RNGLike = None, progress: Progress = False) -> LearningRecord:
     """Run ``method`` on ``task``: :func:`adaptive_pg` for an :class:`~safepg.options.Adaptive`,
     :func:`vanilla_pg` for a :class:`~safepg.options.Vanilla`.

@@ -21,7 +21,8 @@ import sympy as sp
 from safepg import theory
 from safepg.thesis import errata
 from safepg.thesis import scorecard as sc
-from safepg.thesis.experiments import get_experiment, run_experiment, scaled
+from safepg.thesis.experiment_store import run_experiment
+from safepg.thesis.experiments import get_experiment, scaled
 from safepg.thesis.scorecard import links as sc_links
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 

@@ -13,7 +13,7 @@ from typing import NamedTuple
 import pytest
 
 from safepg.thesis import scorecard as sc
-from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec, spec_from_keywords
+from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.outputs import Output
 from safepg.thesis.scorecard.text import MissingValueError, fill, template_fields
 
@@ -133,13 +133,3 @@ def test_the_row_takes_every_field_of_its_spec():
     assert (r.thesis_value, r.ours_value, r.ours_ci95, r.seeds, r.fields) == (0.5301, 0.4864, [0.45, 0.52], 5,
                                                                               {"method": "adaptive"})
 
-
-def test_the_former_keywords_still_name_declared_fields():
-    got = spec_from_keywords(id="t/row", ok=True, **PLACE, **CELLS, **JUDGEMENT, authors_ok=True, authors="1.0",
-                             authors_seeds=5, authors_output="x", seeds=3)
-    assert got.authors == AuthorsColumn(ok=True, text="1.0", seeds=5) and got.seeds == 3
-    assert got.output == Output(value=None, text="x", source="")
-    with pytest.raises(TypeError, match="authors_sedes"):
-        spec_from_keywords(id="t/row", ok=True, **PLACE, **CELLS, **JUDGEMENT, authors_sedes=5)
-    with pytest.raises(TypeError, match="not both"):
-        Builder().add(spec(), seeds=5)

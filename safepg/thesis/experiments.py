@@ -20,18 +20,7 @@ import numpy as np
 
 from safepg.bounds import Range
 from safepg.envs.lqg import LQG
-from safepg.options import (
-    Adaptive,
-    Batches,
-    Departures,
-    ErrorModel,
-    FixedStep,
-    Gradient,
-    Method,
-    SafeStep,
-    Target,
-    Vanilla,
-)
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.runner import RunConfig
 from safepg.runner import make_env as make_core_env
 from safepg.thesis.authors import TABLE_5_4_BUDGET, cartpole_theta_star
@@ -93,7 +82,7 @@ class Experiment:
         return self.configs[0]
 
 
-def _with_gradient(method: Method, **changes: Any) -> Method:
+def _with_gradient(method: Adaptive | Vanilla, **changes: Any) -> Adaptive | Vanilla:
     """``method`` with fields of its :class:`~safepg.options.Gradient` changed."""
     return replace(method, gradient=replace(method.gradient, **changes))
 
