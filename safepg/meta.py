@@ -67,7 +67,7 @@ def coordinate_step(g: float, eps: float, c: float, guarded: bool = True) -> flo
 
 
 def guaranteed_improvement(g: float, eps: float, c: float) -> float:
-    r"""Improvement guaranteed by the step of Corollary 4.2.8 (w.p. :math:`(1-\delta)^m`).
+    r"""Improvement guaranteed by the step of Corollary 4.2.8, with probability :math:`(1-\delta)^m`.
 
     .. math:: \frac{(\|\hat\nabla J\|_\infty - \epsilon)^4}{4c(\|\hat\nabla J\|_\infty + \epsilon)^2}
     """
@@ -136,7 +136,7 @@ def n_zero(g: float, bound: ErrorBound) -> float:
 
 
 def n_star_closed_form(g: float, bound: ErrorBound) -> int:
-    r"""Optimal batch size of Theorem 4.3.2 for eps = d/sqrt(N):
+    r"""Optimal batch size of Theorem 4.3.2 when :math:`\epsilon = d_\delta/\sqrt N` (f = 0).
 
     .. math:: N^* = \Big\lceil \frac{(13 + 3\sqrt{17})\, d_\delta^2}{2\|\hat\nabla J\|_\infty^2}\Big\rceil
     """

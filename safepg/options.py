@@ -350,4 +350,4 @@ class Vanilla:
 Method = Adaptive | Vanilla
 
 __all__ = ["Adaptive", "Assumption", "Batches", "Departures", "ErrorModel", "FixedStep", "Gradient", "Method",
-           "Range", "SafeStep", "StepKind", "Target", "Vanilla"]
+           "SafeStep", "StepKind", "Target", "Vanilla"]
