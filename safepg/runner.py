@@ -238,6 +238,14 @@ def run_configs(
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) and return all records by config name.
 
+    Finished runs are loaded, never recomputed; a damaged run file is set aside (kept as
+    ``seed-<k>.npz.damaged-<time>``), named in a :class:`~safepg.store.DamagedRunWarning`
+    and its run computed again. The runs go to joblib's current backend
+    (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
+    worker returns its record and this process saves it as soon as it arrives, so an
+    interrupted campaign loses nothing already computed and remote workers need no
+    access to ``folder``.
+
     Parameters
     ----------
     configs
@@ -252,14 +260,6 @@ def run_configs(
         joblib's ``n_jobs``: a positive count, or -1 for every core (-2 all but one, ...).
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
-
-    Finished runs are loaded, never recomputed; a damaged run file is set aside (kept as
-    ``seed-<k>.npz.damaged-<time>``), named in a :class:`~safepg.store.DamagedRunWarning`
-    and its run computed again. The runs go to joblib's current backend
-    (local processes, or a Dask/Ray cluster inside ``joblib.parallel_config``); each
-    worker returns its record and this process saves it as soon as it arrives, so an
-    interrupted campaign loses nothing already computed and remote workers need no
-    access to ``folder``.
     """
     from joblib import Parallel, delayed, effective_n_jobs
 
