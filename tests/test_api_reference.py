@@ -184,3 +184,13 @@ def test_built_classes_show_their_parameters(built_page: str) -> None:
             if not set(params) <= shown:
                 bare.append(f"{modname}.{name}: {sorted(set(params) - shown)}")
     assert not bare, f"signatures without their parameters: {bare}"
+
+
+def test_every_parameter_name_is_a_name(built_page: str) -> None:
+    # A paragraph left below a numpydoc Parameters list (no section header of its own) is read as
+    # one more parameter: its first line becomes a bold "name" that cannot wrap on a phone.
+    names = re.findall(r"<dt><strong>([^<]*)</strong>", built_page)
+    assert names, "no parameter lists found in the built page"
+    # A name, or names joined by commas ("progress, desc"); never words separated by spaces.
+    sentences = [n for n in names if any(" " in part.strip() for part in n.split(","))]
+    assert not sentences, f"text read as parameter names (a paragraph after a Parameters list?): {sentences}"
