@@ -325,7 +325,7 @@ def test_every_printed_result_has_a_row(store):
     assert len(ids) == len(rows), "row ids must be unique"
     t51 = exps["table-5.1"]
     for c in t51.configs:
-        r = ids[f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"]
+        r = ids[f"table-5.1/sigma={c.sigma:g}/N={c.method.batch_size}/alpha={c.method.step.alpha:.0e}"]
         assert r.thesis_value == t51.thesis[c.name]["improvement_ratio"]
     assert sum(i.startswith("table-5.1/") for i in ids) == 24
     t52 = exps["table-5.2"]
@@ -333,7 +333,8 @@ def test_every_printed_result_has_a_row(store):
              for r in rows if r.id.startswith("table-5.2/")}
     assert len(got52) == 12
     for c in t52.configs:
-        r = got52[(c.estimator, c.bound, c.empirical_range, c.delta)]
+        e = c.method.error
+        r = got52[(c.method.gradient.estimator, e.bound, e.empirical_range, e.delta)]
         assert r.thesis_value == t52.thesis[c.name]["upsilon_bar"]
         assert r.fields["thesis_ci95"] == list(t52.thesis[c.name]["ci95"])
     for table, n in (("table-5.3", 3), ("table-5.4", 2)):
@@ -355,8 +356,9 @@ def test_every_printed_result_has_a_row(store):
                 "section-5.1/improvement-ratio-adaptive"):
         assert rid in ids
     assert ids["section-5.2/J-star"].thesis_value == -422.616
-    assert all(ids[f"table-5.1/sigma={c.sigma:g}/N={c.batch_size}/alpha={c.alpha:.0e}"].fields["theta0"] == -0.55
-               for c in exps["table-5.1-printed-theta0"].configs)
+    printed = exps["table-5.1-printed-theta0"].configs
+    assert all(ids[f"table-5.1/sigma={c.sigma:g}/N={c.method.batch_size}/alpha={c.method.step.alpha:.0e}"]
+               .fields["theta0"] == -0.55 for c in printed)
     assert ids["section-5.2/theta-star"].thesis_value == -0.588
     assert set(r.group for r in rows) == set(sc.GROUPS)
 
