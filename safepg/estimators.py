@@ -33,7 +33,7 @@ def check_estimator(estimator: str) -> None:
 
 def check_score_action(score_action: str) -> None:
     """Raise ``ValueError("score_action ...")`` unless it is ``"clipped"`` or ``"raw"``."""
-    if score_action not in ("clipped", "raw"):
+    if score_action not in SCORE_ACTIONS:
         raise ValueError(f"score_action must be 'clipped' or 'raw', got {score_action!r}")
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import Literal, NamedTuple
 
 from safepg.bounds import BOUNDS, Bound, Range, check_delta, check_range
-from safepg.estimators import ESTIMATORS, SCORE_ACTIONS, Estimator, ScoreAction
+from safepg.estimators import Estimator, ScoreAction, check_estimator, check_score_action
 
 #: A step applied to all components (``"scalar"``) or to the largest one only (``"coordinate"``).
 StepKind = Literal["scalar", "coordinate"]
@@ -65,9 +65,9 @@ class Gradient:
     score_action: ScoreAction = "clipped"
 
     def __post_init__(self) -> None:
-        _check_choice("estimator", self.estimator, ESTIMATORS)
+        check_estimator(self.estimator)
         _check_flag("baseline", self.baseline)
-        _check_choice("score_action", self.score_action, SCORE_ACTIONS)
+        check_score_action(self.score_action)
 
 
 @dataclass(frozen=True)
