@@ -17,7 +17,7 @@ export VIRTUAL_ENV := $(CURDIR)/.venv
 export JUPYTER_PATH := $(CURDIR)/.venv/share/jupyter
 export JUPYTER_PREFER_ENV_PATH := 1
 
-.PHONY: setup browser-deps lint test test-lib book book-assets bench lab
+.PHONY: setup browser-deps lint test test-lib book book-assets bench lab wasm
 
 # Creates .venv on first use (installing Debian's python3.X-venv as root if missing), reuses
 # it while requirements.txt and pyproject.toml are unchanged.
@@ -55,6 +55,10 @@ book: setup book-assets
 
 bench: setup
 	$(VPY) benchmarks/bench_iteration.py
+
+# The page learner's WebAssembly kernel of the 2-D LQG, from its C source (tools/build_wasm.py).
+wasm: setup
+	$(VPY) tools/build_wasm.py
 
 # JupyterLab on lab/, a git-ignored working copy of the book's chapters refreshed from book/
 # without losing your edits (book/ is never written), with this clone's kernel, on 127.0.0.1

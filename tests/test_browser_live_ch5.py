@@ -123,6 +123,9 @@ def test_lqg2d_adaptive_explorer(browser, pages):
     # Ticking the authors' switch selects their N_max (one run for both).
     assert last["params"]["n_max"] == "100000" and last["params"]["authors"] is True
     assert "Algorithm 4.1 (authors' settings)" in last["result"]["text"]
+    # The Web Worker compiles the WebAssembly kernel, and every run's batches go through it.
+    assert set(last["result"]["values"]["kernel"].values()) == {"webassembly"}, last["result"]["values"]["kernel"]
+    assert "batches in WebAssembly" in pg.page.locator(".safepg-status").text_content()
 
 
 def test_long_run_draws_progressively_and_is_cancelled(browser, pages):
@@ -221,6 +224,7 @@ def test_book_lqg2d_page(browser, book):
     for i in range(2):
         v = _book_explorer_values(pg, roots.nth(i))
         assert v["result"]["values"]["worker"], "the run did not go to a Web Worker"
+        assert set(v["result"]["values"]["kernel"].values()) == {"webassembly"}, v["result"]["values"]["kernel"]
         assert roots.nth(i).locator("svg path").count() > 0
     assert not pg.errors and not pg.remote
 

@@ -37,8 +37,9 @@ Reporter = Callable[[float, str], object]
 #: Bounds offered: (value, label); "-er" is the empirical range.
 BOUND_CHOICES = (("chebyshev", "Chebyshev"), ("hoeffding", "Hoeffding"), ("hoeffding-er", "Hoeffding (e.r.)"),
                  ("bernstein", "Bernstein"), ("bernstein-er", "Bernstein (e.r.)"))
-#: Keys of a page's ``values`` that only the page has (the Web Worker and its timing).
-PAGE_ONLY = ("worker", "elapsed_ms", "run_ms", "error")
+#: Keys of a page's ``values`` that only the page has (the Web Worker, its timing, and which
+#: code computed each run's batches: "webassembly" or "javascript").
+PAGE_ONLY = ("worker", "elapsed_ms", "run_ms", "kernel", "error")
 
 
 def learner_source() -> str:

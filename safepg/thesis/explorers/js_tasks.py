@@ -1,8 +1,10 @@
 """The page learner's JavaScript in one piece, and safepg tasks as the TASK objects it reads.
 
 The learner is split by concept (``static/learner.js``: random numbers, bounds, meta-parameters
-and the 1-D run; ``lqg_task.js``: the LQG in any dimension; ``cartpole_task.js``: the
-cart-pole; ``vector_run.js``: Algorithm 4.1 and vanilla PG on a vector theta). A page, a
+and the 1-D run; ``lqg_task.js``: the LQG in any dimension; ``lqg2d_wasm.js``: the 2-D LQG's
+batch as WebAssembly, compiled from ``wasm/lqg2d_kernel.c``, the same bits in half the time;
+``cartpole_task.js``: the cart-pole; ``vector_run.js``: Algorithm 4.1 and vanilla PG on a
+vector theta). A page, a
 worker and the Node tests load :func:`learner_sources`, their concatenation in dependency
 order, which defines the global ``safepgLearner``. :func:`lqg_task_data` and
 :func:`cartpole_task_data` turn a safepg task into the ``task`` of the learner's
@@ -11,6 +13,8 @@ order, which defines the global ``safepgLearner``. :func:`lqg_task_data` and
 
 from __future__ import annotations
 
+import base64
+from importlib import resources
 from typing import Any
 
 import numpy as np
@@ -21,7 +25,11 @@ from safepg.options import Adaptive, FixedStep, Method, SafeStep
 from safepg.thesis.explorers.component import static_text
 
 #: The learner's files in the order they must be concatenated (each extends the ones before).
-LEARNER_FILES = ("learner.js", "lqg_task.js", "cartpole_task.js", "vector_run.js")
+LEARNER_FILES = ("learner.js", "lqg_task.js", "lqg2d_wasm.js", "cartpole_task.js", "vector_run.js")
+#: The 2-D LQG's batch as WebAssembly (``make wasm`` compiles it from ``wasm/lqg2d_kernel.c``),
+#: carried inline by ``lqg2d_wasm.js`` in place of :data:`WASM_PLACEHOLDER`.
+WASM_KERNEL = "lqg2d_kernel.wasm"
+WASM_PLACEHOLDER = "@LQG2D_KERNEL_WASM@"
 
 
 def learner_sources() -> str:
@@ -32,7 +40,9 @@ def learner_sources() -> str:
     str
         Script text; under Node, ``require`` of a file holding it returns ``safepgLearner``.
     """
-    return "\n".join(static_text(name) for name in LEARNER_FILES)
+    kernel = resources.files("safepg.thesis.explorers").joinpath("static", WASM_KERNEL).read_bytes()
+    text = "\n".join(static_text(name) for name in LEARNER_FILES)
+    return text.replace(WASM_PLACEHOLDER, base64.b64encode(kernel).decode("ascii"), 1)
 
 
 def _matrix(x: Any, m: int) -> list[float]:

@@ -53,14 +53,17 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
     const res = page.result(st.p, st, data);
     Object.assign(res.values, {done: st.done, worker: st.worker, elapsed_ms: st.elapsed, error: st.error});
     res.values.run_ms = {};
-    for (const k in st.runs) res.values.run_ms[k] = st.runs[k].ms;
+    res.values.kernel = {};  // per run: "webassembly" (the 2-D LQG's kernel) or "javascript"
+    for (const k in st.runs) { res.values.run_ms[k] = st.runs[k].ms; res.values.kernel[k] = st.runs[k].kernel; }
+    const wasm = Object.values(st.runs).some(r => r.kernel === "webassembly");
     for (const plot of spec.plots)
       safepgPlot(root.querySelector(`svg[data-plot="${plot.id}"]`), plot, res.plots[plot.id]);
     root.querySelector(".safepg-text").innerHTML = res.text;
     let used = 0;
     for (const k in st.runs) used += st.runs[k].used || 0;
     statusEl.textContent = st.error ? `error: ${st.error}` : st.done
-      ? `done in ${(st.elapsed / 1000).toFixed(2)} s (${st.worker ? "Web Worker" : "page thread"})`
+      ? `done in ${(st.elapsed / 1000).toFixed(2)} s (${st.worker ? "Web Worker" : "page thread"}` +
+        `${wasm ? ", batches in WebAssembly" : ""})`
       : `running: ${used.toLocaleString("en-US")} of ${st.total.toLocaleString("en-US")} trajectories...`;
     valuesEl.textContent = JSON.stringify({params: st.p, job: st.job, result: res});
   }
@@ -82,7 +85,7 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
         r.J.push(part.J ? safepgCh5Num(part.J[i]) : null);
         r.c.push(part.c ? safepgCh5Num(part.c[i]) : null);
       }
-      r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms;
+      r.used = part.used; r.done = part.done; r.diverged = part.diverged; r.ms = part.ms; r.kernel = part.kernel;
     }
     st.elapsed = performance.now() - st.t0;
     if (msg.type === "done") st.done = true;

@@ -493,13 +493,15 @@ const safepgLearner = (function () {
               batchSize: rec.batchSize.slice(i0, i1), alpha: rec.alpha.slice(i0, i1),
               eps: rec.eps.slice(i0, i1), Jhat: rec.Jhat.slice(i0, i1), grad: rec.grad.slice(i0, i1),
               theta: rec.theta.slice(i0 + 1, i1 + 1), J: rec.J.slice(i0 + 1, i1 + 1),
-              used: r.run.used, done: r.run.done, diverged: r.run.diverged, ms: r.ms};
+              used: r.run.used, done: r.run.done, diverged: r.run.diverged, ms: r.ms,
+              kernel: r.run.kernel || "javascript"};
     });
   };
 
   return {Rng, pairwiseSum, sampleVariance, range, lqgPerformance, reinforceVarianceFactor, gpomdpVarianceFactor,
           gradientRangeBound, penaltyConstant, chebyshev, hoeffding, bernstein, eps, errorBound, coordinateStep,
           nZero, upsilon, nStarClosedForm, nStarSearch, optimalBatchSize, adaptiveUpdate, Workspace,
-          gradientSamples, rngDraw, Run, Driver, summary, THESIS_1D, DEFAULTS, N_STAR_FACTOR};
+          gradientSamples, rngDraw, Run, Driver, summary, THESIS_1D, DEFAULTS, N_STAR_FACTOR,
+          ZIGGURAT: Object.freeze({kn, wn, fn})};
 })();
 if (typeof module !== "undefined" && module.exports) module.exports = safepgLearner;

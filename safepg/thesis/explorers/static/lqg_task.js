@@ -212,6 +212,7 @@
    * (what safepg.learning measures on a simulated batch), else null.
    */
   LqgBatch.prototype.run = function (theta, sigma, n, opt, src) {
+    this.kernel = "javascript";  // which code computed the last batch (run2 may say "webassembly")
     if (this.m === 2) return this.run2(theta, sigma, n, opt, src);
     const task = this.task, m = this.m, M = this.M, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
@@ -283,11 +284,16 @@
 
   /**
    * run() for m = 2 with the 2 x 2 algebra unrolled (the 2-D kernel of safepg): the same sums
-   * in the same order as the generic loop, so the same bits, about three times faster.
+   * in the same order as the generic loop, so the same bits, about three times faster. The
+   * figures' case goes to the WebAssembly kernel of lqg2d_wasm.js when the run draws its own
+   * numbers (the same bits again), else to run2gb.
    */
   LqgBatch.prototype.run2 = function (theta, sigma, n, opt, src) {
-    if (opt.estimator !== "reinforce" && opt.baseline && opt.score !== "raw" && this.task.clip !== false)
-      return this.run2gb(theta, sigma, n, opt, src);
+    if (opt.estimator !== "reinforce" && opt.baseline && opt.score !== "raw" && this.task.clip !== false) {
+      const found = L.lqg2dWasm ? L.lqg2dWasm.run(this, theta, sigma, n, opt, src) : undefined;
+      this.kernel = found !== undefined ? "webassembly" : "javascript";
+      return found !== undefined ? found : this.run2gb(theta, sigma, n, opt, src);
+    }
     const task = this.task, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
     const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";

@@ -68,6 +68,7 @@
   /** The random numbers of a run from its own generator (learner.js's Rng). */
   function rngSource(rng) {
     return {
+      rng,  // the WebAssembly kernel draws the same normals from this generator's state (lqg2d_wasm.js)
       init(s, n, dim, lo, hi) {
         for (let j = 0; j < n; j++) for (let i = 0; i < dim; i++) s[i * n + j] = lo + (hi - lo) * rng.uniform();
       },
@@ -163,6 +164,7 @@
     const n = Math.min(this.n, cfg.budget - this.used);
     if (n < 2) { this.done = true; return false; }
     const found = bt.run(this.theta, cfg.sigma, n, cfg, this.src);
+    this.kernel = bt.kernel || "javascript";
     const x = bt.samples, grad = this.grad;
     // numpy's samples.sum(axis=0) adds the rows one after the other.
     let finite = true;
