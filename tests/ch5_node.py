@@ -12,20 +12,32 @@ from typing import Any
 from safepg.thesis.explorers.component import static_text
 
 NODE = shutil.which("node")
+#: Control moves that each change what the Chapter 5 explorers draw, in the page
+#: (tests/test_browser_live_ch5.py) and in the kernel view (tests/test_kernel_view_ch5.py).
+CH5_MOVES: dict[str, list[tuple[str, Any]]] = {
+    "steps": [("budget", "30000"), ("delta", 0.5), ("sigma", 0.75), ("bound", "bernstein-er"), ("n", "1000"),
+              ("seed", 5.0)],
+    "adaptive": [("budget", "30000"), ("delta", 0.5), ("sigma", 1.5), ("bound", "chebyshev"), ("seed", 3.0),
+                 ("n_max", "10000"), ("authors", True)],
+    "cartpole": [("budget", "10000"), ("deg12", True), ("ml005", True), ("gamma09", True), ("batch_constants", True),
+                 ("max_stats", True), ("unguarded", True), ("first1000", True), ("start", "theta_star"),
+                 ("delta", 0.5), ("sigma", 0.75), ("seed", 2.0), ("budget", "20000")],
+}
 _SCRIPT = r"""
 const src = require("fs").readFileSync(0, "utf8");
 const req = JSON.parse(src);
-const page = new Function(req.src + "\nreturn " + req.object + ";")();
+const [page, linked] = new Function(req.src + "\nreturn [" + req.object + ", safepgCh5Linked];")();
 const out = req.cases.map(c => ({
   configs: c.configs ? page.configs(c.p, c.data) : null,
   result: c.traces ? page.result(c.p, {runs: c.traces}, c.data) : null,
-  linked: c.linked ? page.linked(c.linked[0], c.linked[1]) : null}));
+  linked: c.linked ? linked(c.links, c.linked[0], c.linked[1]) : null}));
 process.stdout.write(JSON.stringify(out));
 """
 
 
 def run_page(script: str, obj: str, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces", "linked"}``."""
+    """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces"}``, or
+    ``{"links", "linked": [name, value]}`` for the page's answer to a control's move (``safepgCh5Linked``)."""
     src = static_text("live_jobs.js") + "\n" + static_text("ch5_page.js") + "\n" + static_text(script)
     proc = subprocess.run([NODE, "-e", _SCRIPT], input=json.dumps({"src": src, "object": obj, "cases": cases}),
                           capture_output=True, text=True, timeout=120, check=False)

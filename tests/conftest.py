@@ -1,4 +1,5 @@
-"""Shared fixtures of the browser tests: the built book and Debian's headless Chromium.
+"""Shared fixtures: the built book and Debian's headless Chromium for the browser tests, and
+``views`` for the tests of the explorers' kernel views.
 
 ``book`` builds the book once per session (notebook execution goes through the
 Jupyter Book cache, so a rebuild with unchanged notebooks takes seconds);
@@ -81,3 +82,14 @@ def browser() -> Iterator[Any]:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield browser
         browser.close()
+
+
+@pytest.fixture
+def views() -> Iterator[list[Any]]:
+    """Kernel views (``Explorer.interactive()``) a test makes, closed after it (their worker threads end)."""
+    made: list[Any] = []
+    yield made
+    for v in made:
+        v.close()
+        v._thread.join(10)
+        assert not v._thread.is_alive()

@@ -13,6 +13,7 @@ from typing import Any
 
 import pytest
 from browser_pages import OfflinePage
+from ch5_node import CH5_MOVES
 
 from safepg.thesis.explorers.ch5_live import PAGE_ONLY
 
@@ -107,9 +108,7 @@ def drive(browser, path: Path, explorer: Any, moves: list[tuple[str, Any]], shot
 
 def test_lqg2d_steps_explorer(browser, pages):
     path, ex = pages["steps"]
-    moves = [("budget", "30000"), ("delta", 0.5), ("sigma", 0.75), ("bound", "bernstein-er"), ("n", "1000"),
-             ("seed", 5.0)]
-    pg, last = drive(browser, path, ex, moves, "live-lqg2d-steps")
+    pg, last = drive(browser, path, ex, CH5_MOVES["steps"], "live-lqg2d-steps")
     v = last["result"]["values"]
     assert v["scalar"]["trajectories"] == v["coordinate"]["trajectories"] == 30_000
     assert [len(s["y"]) for s in last["result"]["plots"]["theta"]["series"]] == [31] * 4  # 30 updates and theta_0
@@ -117,9 +116,7 @@ def test_lqg2d_steps_explorer(browser, pages):
 
 def test_lqg2d_adaptive_explorer(browser, pages):
     path, ex = pages["adaptive"]
-    moves = [("budget", "30000"), ("delta", 0.5), ("sigma", 1.5), ("bound", "chebyshev"), ("seed", 3.0),
-             ("n_max", "10000"), ("authors", True)]
-    pg, last = drive(browser, path, ex, moves, "live-lqg2d-adaptive")
+    pg, last = drive(browser, path, ex, CH5_MOVES["adaptive"], "live-lqg2d-adaptive")
     # Ticking the authors' switch selects their N_max (one run for both).
     assert last["params"]["n_max"] == "100000" and last["params"]["authors"] is True
     assert "Algorithm 4.1 (authors' settings)" in last["result"]["text"]
@@ -150,10 +147,7 @@ def test_long_run_draws_progressively_and_is_cancelled(browser, pages):
 
 def test_cartpole_explorer(browser, pages):
     path, ex = pages["cartpole"]
-    moves = [("budget", "10000"), ("deg12", True), ("ml005", True), ("gamma09", True), ("batch_constants", True),
-             ("max_stats", True), ("unguarded", True), ("first1000", True), ("start", "theta_star"),
-             ("delta", 0.5), ("sigma", 0.75), ("seed", 2.0), ("budget", "20000")]
-    pg, _ = drive(browser, path, ex, moves, "live-cartpole")
+    pg, _ = drive(browser, path, ex, CH5_MOVES["cartpole"], "live-cartpole")
     # The thesis's text, then the authors' settings: each one click.
     job = pg.values()["job"]
     pg.page.get_by_role("button", name="the thesis's text").click()

@@ -17,19 +17,7 @@ pytest.importorskip("ipywidgets")
 
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider  # noqa: E402
 from safepg.thesis.explorers.curves import lqg_explorer, upsilon_explorer  # noqa: E402
-from safepg.thesis.explorers.kernel_view import ExplorerView  # noqa: E402
 from safepg.thesis.explorers.live_learner import live_batch_size_explorer  # noqa: E402
-
-
-@pytest.fixture
-def views():
-    """Views made by a test, closed after it (their worker threads end)."""
-    made: list[ExplorerView] = []
-    yield made
-    for v in made:
-        v.close()
-        v._thread.join(10)
-        assert not v._thread.is_alive()
 
 
 def other_value(c: Slider | Select) -> Any:

@@ -98,7 +98,8 @@ def test_page_configs_are_the_python_settings(steps, adaptive):
                      [{"p": {**base_s, **m}, "data": steps.data, "configs": True} for m in moves_s])
     out_a = run_page("lqg2d_page.js", "safepgLqg2dAdaptive",
                      [{"p": {**base_a, **m}, "data": adaptive.data, "configs": True} for m in moves_a]
-                     + [{"p": base_a, "data": adaptive.data, "linked": ["authors", v]} for v in (True, False)])
+                     + [{"p": base_a, "data": adaptive.data, "links": adaptive._spec()["links"],
+                         "linked": ["authors", v]} for v in (True, False)])
     for (fn, base, moves, out) in ((steps_configs, base_s, moves_s, out_s), (adaptive_configs, base_a, moves_a, out_a)):
         for m, got in zip(moves, out):
             p = {**base, **m}
@@ -118,6 +119,7 @@ def test_page_configs_are_the_python_settings(steps, adaptive):
                     elif not (fixed_step and k in ("bound", "empiricalRange", "delta")):  # no bound in a fixed step
                         assert cfg[k] == v, (m, name, k)
     assert out_a[-2]["linked"] == {"n_max": "100000"} and out_a[-1]["linked"] == {"n_max": "500000"}
+    assert [adaptive.linked("authors", v) for v in (True, False)] == [out_a[-2]["linked"], out_a[-1]["linked"]]
 
 
 def small_traces(p, budget=3000):

@@ -170,7 +170,9 @@ def kernel_text(res: dict[str, Any]) -> dict[str, Any]:
 class Ch5LiveExplorer(Explorer):
     """An :class:`~safepg.thesis.explorers.component.Explorer` whose page runs the JavaScript
     learner in a Web Worker (see the module docstring); ``compute_js`` names the page script,
-    ``presets`` are one-click buttons setting several controls (name -> (label, values))."""
+    ``presets`` are one-click buttons setting several controls (name -> (label, values)), and
+    ``links`` controls that set others when they take a value (name -> ((value, {other: value}), ...)),
+    in the page and in the kernel view alike."""
 
     continuous_update = False
     compute_reports_progress = True
@@ -178,13 +180,22 @@ class Ch5LiveExplorer(Explorer):
     page_script: str = ""
     page_object: str = ""
     presets: dict[str, tuple[str, dict[str, Any]]] = {}
+    links: dict[str, tuple[tuple[Any, dict[str, Any]], ...]] = {}
+
+    def linked(self, name: str, value: Any) -> dict[str, Any]:
+        """The controls that control ``name`` sets on taking ``value``, and their values (``{}`` for none)."""
+        for v, sets in self.links.get(name, ()):
+            if v == value:
+                return dict(sets)
+        return {}
 
     def _presets_html(self) -> str:
         return "".join(f'<button type="button" data-preset="{html.escape(k)}" style="margin:0 0.6em 0.4em 0">'
                        f"{html.escape(label)}</button>" for k, (label, _) in self.presets.items())
 
     def _spec(self) -> dict[str, Any]:
-        return {**super()._spec(), "presets": {k: v for k, (_, v) in self.presets.items()}}
+        return {**super()._spec(), "presets": {k: v for k, (_, v) in self.presets.items()},
+                "links": {k: [[v, sets] for v, sets in pairs] for k, pairs in self.links.items()}}
 
     def to_html(self) -> str:
         """The self-contained HTML + JavaScript block (learner, worker and plots inline)."""
@@ -207,10 +218,20 @@ class Ch5LiveExplorer(Explorer):
         )
 
     def interactive(self) -> Any:
-        """The kernel view, with the preset buttons: a click sets the controls they name."""
+        """The kernel view, with the preset buttons (a click sets the controls they name) and the
+        links (a control that takes a linked value sets the others, as in the page)."""
         import ipywidgets as w
 
         view = super().interactive()
+
+        def follow(name: str) -> Callable[[Mapping[str, Any]], None]:
+            def moved(change: Mapping[str, Any]) -> None:
+                for k, v in self.linked(name, change["new"]).items():
+                    view.controls[k].value = v
+            return moved
+
+        for name in self.links:
+            view.controls[name].observe(follow(name), names="value")
 
         def press(values: Mapping[str, Any]) -> Callable[[Any], None]:
             def click(_: Any) -> None:

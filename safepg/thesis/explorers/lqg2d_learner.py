@@ -265,6 +265,9 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     ex = Ch5LiveExplorer("Figures 5.7-5.8 live: adaptive batch size against fixed N on the 2-D LQG, computed in "
                          "your browser", controls, plots, "", compute_py, data)
     ex.page_script, ex.page_object = "lqg2d_page.js", "safepgLqg2dAdaptive"
+    # The authors' switch selects their N_max; off, the thesis's.
+    ex.links = {"authors": ((True, {"n_max": str(authors_2d().batches.n_max)}),
+                            (False, {"n_max": str(method.batches.n_max)}))}
     ex.kernel_title = "Figures 5.7-5.8: adaptive against fixed batch sizes on the 2-D LQG, rerun by safepg here"
     return ex
 

@@ -23,6 +23,11 @@ function safepgCh5Summary(r) {
           improvement_ratio: I && hasJ ? up / I : null, J_final: safepgCh5Num(r.J[I]), theta_final: r.theta[I],
           theta_moved: moved.map(safepgCh5Num), done: !!r.done, diverged: !!r.diverged};
 }
+function safepgCh5Linked(links, name, value) {
+  // Ch5LiveExplorer.linked: the controls that control `name` sets on taking `value`.
+  for (const [v, sets] of (links && links[name]) || []) if (v === value) return sets;
+  return {};
+}
 function safepgCh5IterSeries(r, key, points, index, perUpdate) {
   // ch5_live.iteration_series.
   const ys = r[key], keep = safepgThin(ys.length, points);
@@ -123,7 +128,7 @@ function safepgCh5Live(root, spec, learnerSrc, page) {
     if (inp.type === "checkbox") inp.checked = !!value; else inp.value = String(value);
   }
   inputs.forEach(inp => inp.addEventListener(inp.type === "checkbox" ? "change" : "input", () => {
-    if (page.linked) for (const [k, v] of Object.entries(page.linked(inp.dataset.param, safepgParam(inp)))) set(k, v);
+    for (const [k, v] of Object.entries(safepgCh5Linked(spec.links, inp.dataset.param, safepgParam(inp)))) set(k, v);
     start();
   }));
   root.querySelectorAll("[data-preset]").forEach(b => b.addEventListener("click", () => {

@@ -57,10 +57,6 @@ const safepgLqg2dAdaptive = {
                                    stopOnDivergence: true, stream: runs.length}});
     return {task: data.task, runs: runs};
   },
-  linked(name, value) {
-    // The authors' switch selects their N_max (100000); off, the thesis's 500000.
-    return name === "authors" ? {n_max: value ? "100000" : "500000"} : {};
-  },
   result(p, st, data) {
     const plots = {J: {series: []}, N: {series: []}}, values = {}, lines = [];
     for (const [name, color] of data.runs) {
