@@ -136,16 +136,23 @@ def best_of(f, repeat: int) -> dict[str, float]:
     return {"wall_ms": 1e3 * wall, "cpu_ms": 1e3 * cpu}
 
 
-def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
-    """Wall times (s) of the explorer's 10^6-trajectory adaptive run in headless Chromium."""
+def chromium_path() -> str | None:
+    """Debian's Chromium, if it and Playwright are installed (the browser measurements need both)."""
     chromium = shutil.which("chromium") or "/usr/bin/chromium"
     try:
-        from playwright.sync_api import sync_playwright
+        import playwright.sync_api  # noqa: F401
     except ImportError:
         return None
-    if not Path(chromium).exists():
+    return chromium if Path(chromium).exists() else None
+
+
+def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
+    """Wall times (s) of the explorer's 10^6-trajectory adaptive run in headless Chromium."""
+    chromium = chromium_path()
+    if chromium is None:
         return None
     import psutil
+    from playwright.sync_api import sync_playwright
 
     from safepg.thesis.explorers.live_learner import live_batch_size_explorer
 
@@ -188,13 +195,11 @@ def chromium_runs(seeds: int) -> dict[str, list[float]] | None:
 
 def chromium_worker(vec: dict[str, object], repeat: int) -> dict[str, object] | None:
     """The vector tasks' measurements (VECTOR_BENCH) inside a Web Worker of headless Chromium."""
-    chromium = shutil.which("chromium") or "/usr/bin/chromium"
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
+    chromium = chromium_path()
+    if chromium is None:
         return None
-    if not Path(chromium).exists():
-        return None
+    from playwright.sync_api import sync_playwright
+
     from safepg.thesis.explorers.js_tasks import learner_sources
 
     # The small placeholders first: the learner's text is inserted last, as it is.
