@@ -27,6 +27,7 @@ def compile_kernel(out: Path) -> None:
     """Compile :data:`SOURCE` to ``out`` (raises ``CalledProcessError`` with clang's message)."""
     subprocess.run([sys.executable, "-m", "ziglang", "cc", *FLAGS, "-o", str(out.resolve()), SOURCE.name], check=True,
                    cwd=SOURCE.parent)
+    out.chmod(0o644)  # the linker marks its output executable; a module is data
 
 
 def main() -> None:
