@@ -92,19 +92,31 @@ function safepgPlot(svg, spec, res) {
   el("text", {x: (W + m.l) / 2, y: Hh - 6, "text-anchor": "middle", "font-size": 12, ...ink}, spec.xlabel || "");
   el("text", {x: 14, y: (Hh - m.b) / 2, "text-anchor": "middle", "font-size": 12, ...ink,
               transform: `rotate(-90 14 ${(Hh - m.b) / 2})`}, spec.ylabel || "");
-  let ly = m.t + 16;
+  const lineOf = s => ({stroke: s.color || "currentColor", "stroke-width": 2, "stroke-dasharray": s.dash ? "6 4" : ""});
   for (const s of res.series) {
     const d = s.x.map((x, i) => [x, s.y[i]]).filter(p => isFinite(tx(p[0])) && isFinite(ty(p[1])))
       .map((p, i) => `${i ? "L" : "M"}${X(p[0]).toFixed(1)},${Y(p[1]).toFixed(1)}`).join("");
-    const dash = s.dash ? "6 4" : "";
-    const line = {stroke: s.color || "currentColor", "stroke-width": 2, "stroke-dasharray": dash};
-    el("path", {d: d, fill: "none", ...line, class: "safepg-series"});
-    if (s.label) {  // legend: label and a line sample, top right
-      el("text", {x: W - m.r - 38, y: ly, "text-anchor": "end", "font-size": 11, ...ink}, s.label);
-      el("line", {x1: W - m.r - 32, x2: W - m.r - 8, y1: ly - 4, y2: ly - 4, ...line});
-      ly += 15;
-    }
+    el("path", {d: d, fill: "none", ...lineOf(s), class: "safepg-series"});
   }
+  // The legend sits under the plot, not inside it, so that no entry covers a line: rows of a line
+  // sample and its label, as many rows as the entries need; the drawing grows by them.
+  const rows = [];
+  let row = [], used = 0;
+  for (const s of res.series.filter(s => s.label)) {
+    const width = 30 + SAFEPG_CHAR_WIDTH * s.label.length;
+    if (row.length && used + width > W - m.l - m.r) { rows.push(row); row = []; used = 0; }
+    row.push([s, used]);
+    used += width + 18;
+  }
+  if (row.length) rows.push(row);
+  rows.forEach((r, i) => {
+    const y = Hh + 12 + 16 * i;
+    for (const [s, x] of r) {
+      el("line", {x1: m.l + x, x2: m.l + x + 24, y1: y - 4, y2: y - 4, ...lineOf(s), class: "safepg-legend"});
+      el("text", {x: m.l + x + 30, y: y, "font-size": 11, ...ink, class: "safepg-legend"}, s.label);
+    }
+  });
+  if (rows.length) svg.setAttribute("viewBox", `0 0 ${W} ${Hh + 8 + 16 * rows.length}`);
   for (const mk of (res.markers || [])) {
     if (!isFinite(tx(mk.x)) || !isFinite(ty(mk.y))) continue;
     el("circle", {cx: X(mk.x), cy: Y(mk.y), r: 5, fill: mk.color || "currentColor", class: "safepg-marker"});
