@@ -13,7 +13,7 @@
   const BASE64 = "@LQG2D_KERNEL_WASM@";
   const FIELDS = 15;  // doubles a trajectory keeps in the kernel (its enum FIELDS)
   // The members of the kernel's io struct, in the order of its io_members.
-  const IO_MEMBERS = ["kn", "wn", "fn", "cf", "rng", "found", "exp2", "knInt"];
+  const IO_MEMBERS = ["kn", "wn", "fn", "cf", "rng", "found", "exp2"];
   let kernel = null, failed = false;
 
   function bytes(text) {
@@ -29,8 +29,8 @@
       const ex = inst.exports, mem = ex.memory.buffer, offsets = new Int32Array(mem, ex.io_members(), IO_MEMBERS.length);
       const at = {};
       IO_MEMBERS.forEach((name, i) => { at[name] = ex.io() + offsets[i]; });
-      for (const name of ["kn", "wn", "fn"]) new Float64Array(mem, at[name], 128).set(L.ZIGGURAT[name]);
-      new Uint32Array(mem, at.knInt, 128).set(L.ZIGGURAT.kn);
+      new Uint32Array(mem, at.kn, 128).set(L.ZIGGURAT.kn);  // integers below 2^31 (the kernel's io.kn)
+      for (const name of ["wn", "fn"]) new Float64Array(mem, at[name], 128).set(L.ZIGGURAT[name]);
       new Float64Array(mem, at.exp2, 32).set(Array.from({length: 32}, (_, j) => Math.pow(2, j / 32)));
       kernel = {ex, io: at, base: (ex.__heap_base.value + 15) & ~15, cap: -1};
     } catch (err) {

@@ -31,12 +31,12 @@ __attribute__((import_module("env"), import_name("log"))) double js_log(double);
 
 /* What JavaScript writes before a call and reads after it. */
 static struct {
-    double kn[128], wn[128], fn[128]; /* the ziggurat's tables, from learner.js */
+    uint32_t kn[128];                 /* the ziggurat's tables, from learner.js: kn (integers */
+    double wn[128], fn[128];          /* below 2^31, so the tests on them compare integers), wn, fn */
     double cf[24];                    /* theta, A, B, Q, R (row-major 2 x 2), bs, ba, sigma, gamma */
     uint32_t rng[4];                  /* xoshiro128** state, in and out */
     double found[2];                  /* max |r_t|, max |s_i| over the batch (maxima) */
     double exp2_32[32];               /* 2^(j / 32), from Math.pow (within 1 ulp) */
-    uint32_t kn_int[128];             /* kn, integers below 2^31: the fast path compares integers */
 } io;
 
 __attribute__((export_name("io"))) void *io_address(void) { return &io; }
@@ -46,7 +46,7 @@ static const int32_t io_members[] = {
     __builtin_offsetof(__typeof__(io), kn),    __builtin_offsetof(__typeof__(io), wn),
     __builtin_offsetof(__typeof__(io), fn),    __builtin_offsetof(__typeof__(io), cf),
     __builtin_offsetof(__typeof__(io), rng),   __builtin_offsetof(__typeof__(io), found),
-    __builtin_offsetof(__typeof__(io), exp2_32), __builtin_offsetof(__typeof__(io), kn_int)};
+    __builtin_offsetof(__typeof__(io), exp2_32)};
 __attribute__((export_name("io_members"))) const int32_t *io_members_address(void) { return io_members; }
 
 /* ------------------------------------------------------------------ random numbers */
@@ -89,6 +89,12 @@ static int below_exp(double level, double y) {
     return level < js_exp(y);
 }
 
+/* Math.abs(hz) < kn[iz], the ziggurat's test for a draw inside layer iz's rectangle: |hz| as an
+ * unsigned integer (2^31 included) against kn's integers, the same answer as JavaScript's doubles. */
+static inline int inside(int32_t hz, int iz) {
+    return (hz < 0 ? 0u - (uint32_t)hz : (uint32_t)hz) < io.kn[iz];
+}
+
 /* Rng.prototype._zigSlow: the wedges and the tail (about 2.7% of the draws). */
 __attribute__((noinline)) static double zig_slow(Xoshiro *x, int32_t hz, int iz) {
     for (;;) {
@@ -104,15 +110,13 @@ __attribute__((noinline)) static double zig_slow(Xoshiro *x, int32_t hz, int iz)
         if (below_exp(io.fn[iz] + uniform(x) * (io.fn[iz - 1] - io.fn[iz]), -0.5 * v * v)) return v;
         hz = (int32_t)next_u32(x);
         iz = (int)(next_u32(x) & 127u);
-        const double h = (double)hz;
-        if ((h < 0 ? -h : h) < io.kn[iz]) return h * io.wn[iz];
+        if (inside(hz, iz)) return (double)hz * io.wn[iz];
     }
 }
 
 /* Rng.prototype.fillNormal(out, 0, count): one output gives four normals their layers. */
 static void fill_normal(Xoshiro *state, double *restrict out, int count) {
     Xoshiro x = *state;
-    const uint32_t *restrict kn = io.kn_int;
     const double *restrict wn = io.wn;
     uint32_t layers = 0;
     int left = 0;
@@ -121,8 +125,7 @@ static void fill_normal(Xoshiro *state, double *restrict out, int count) {
         const int iz = (int)(layers & 127u);
         layers >>= 8; left -= 1;
         const int32_t hz = (int32_t)next_u32(&x);
-        const uint32_t magnitude = hz < 0 ? 0u - (uint32_t)hz : (uint32_t)hz; /* |hz|, 2^31 included */
-        if (magnitude < kn[iz]) { /* Math.abs(hz) < kn[iz]: both are integers */
+        if (inside(hz, iz)) {
             out[i] = (double)hz * wn[iz];
         } else {
             Xoshiro spill = x;
