@@ -64,11 +64,7 @@
     const task = batch.task, at = layout(k, n);
     batch.grow(n);
     const buf = k.ex.memory.buffer;
-    const cf = new Float64Array(buf, k.io.cf, 24);
-    for (let i = 0; i < 4; i++) {
-      cf[i] = theta[i]; cf[4 + i] = task.A[i]; cf[8 + i] = task.B[i]; cf[12 + i] = task.Q[i]; cf[16 + i] = task.R[i];
-    }
-    cf[20] = task.stateBound; cf[21] = task.actionBound; cf[22] = sigma; cf[23] = task.gamma;
+    batch.constants2(theta, sigma, new Float64Array(buf, k.io.cf, 24));
     const state = new Int32Array(buf, k.io.rng, 4);
     state.set(src.rng.s);
     const maxima = opt.constants === "batch";

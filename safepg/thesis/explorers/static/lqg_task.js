@@ -291,8 +291,9 @@
   LqgBatch.prototype.run2 = function (theta, sigma, n, opt, src) {
     if (opt.estimator !== "reinforce" && opt.baseline && opt.score !== "raw" && this.task.clip !== false) {
       const found = L.lqg2dWasm ? L.lqg2dWasm.run(this, theta, sigma, n, opt, src) : undefined;
-      this.kernel = found !== undefined ? "webassembly" : "javascript";
-      return found !== undefined ? found : this.run2gb(theta, sigma, n, opt, src);
+      if (found === undefined) return this.run2gb(theta, sigma, n, opt, src);
+      this.kernel = "webassembly";
+      return found;
     }
     const task = this.task, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
@@ -362,6 +363,19 @@
   };
 
   /**
+   * The 2-D batch's 24 constants into cf, in the order run2gb and the WebAssembly kernel (its
+   * io.cf) read them: theta, A, B, Q, R (row-major 2 x 2 each), stateBound, actionBound, sigma, gamma.
+   */
+  LqgBatch.prototype.constants2 = function (theta, sigma, cf) {
+    const task = this.task;
+    for (let i = 0; i < 4; i++) {
+      cf[i] = theta[i]; cf[4 + i] = task.A[i]; cf[8 + i] = task.B[i]; cf[12 + i] = task.Q[i]; cf[16 + i] = task.R[i];
+    }
+    cf[20] = task.stateBound; cf[21] = task.actionBound; cf[22] = sigma; cf[23] = task.gamma;
+    return cf;
+  };
+
+  /**
    * run2 for G(PO)MDP with baselines, clipped task, clipped-action score (the figures' runs):
    * each trajectory's state, score, baseline and sample sums sit side by side in one array
    * (ST = 16 doubles a trajectory), so a step reads and writes one block, with no branch on
@@ -375,11 +389,7 @@
     const st = this.st, s = this.s, z = this.z, samples = this.samples, returns = this.returns;
     // The constants pass through a Float64Array so that the loop holds them as doubles: a matrix
     // entry or bound that is an integer (1, 0, 2 from JSON) would otherwise be converted at each use.
-    const cf = this.cf || (this.cf = new Float64Array(24));
-    for (let i = 0; i < 4; i++) {
-      cf[i] = theta[i]; cf[4 + i] = task.A[i]; cf[8 + i] = task.B[i]; cf[12 + i] = task.Q[i]; cf[16 + i] = task.R[i];
-    }
-    cf[20] = task.stateBound; cf[21] = task.actionBound; cf[22] = sigma; cf[23] = task.gamma;
+    const cf = this.constants2(theta, sigma, this.cf || (this.cf = new Float64Array(24)));
     const k00 = cf[0], k01 = cf[1], k10 = cf[2], k11 = cf[3], a00 = cf[4], a01 = cf[5], a10 = cf[6], a11 = cf[7];
     const b00 = cf[8], b01 = cf[9], b10 = cf[10], b11 = cf[11], q00 = cf[12], q01 = cf[13], q10 = cf[14], q11 = cf[15];
     const r00 = cf[16], r01 = cf[17], r10 = cf[18], r11 = cf[19], bs = cf[20], ba = cf[21], sg = cf[22], gm = cf[23];
