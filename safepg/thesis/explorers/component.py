@@ -55,6 +55,12 @@ def static_text(name: str) -> str:
     return resources.files("safepg.thesis.explorers").joinpath("static", name).read_text(encoding="utf-8")
 
 
+def static_bytes(name: str) -> bytes:
+    """The bytes of a binary file in the package's ``static/`` folder (``"lqg2d_kernel.wasm"``), found
+    as :func:`static_text` finds a text file."""
+    return resources.files("safepg.thesis.explorers").joinpath("static", name).read_bytes()
+
+
 @dataclass(frozen=True)
 class Slider:
     """A numeric control."""

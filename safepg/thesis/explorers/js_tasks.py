@@ -14,7 +14,6 @@ order, which defines the global ``safepgLearner``. :func:`lqg_task_data` and
 from __future__ import annotations
 
 import base64
-from importlib import resources
 from typing import Any
 
 import numpy as np
@@ -22,7 +21,7 @@ import numpy as np
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
 from safepg.options import Adaptive, FixedStep, Method, SafeStep
-from safepg.thesis.explorers.component import static_text
+from safepg.thesis.explorers.component import static_bytes, static_text
 
 #: The learner's files in the order they must be concatenated (each extends the ones before).
 LEARNER_FILES = ("learner.js", "lqg_task.js", "lqg2d_wasm.js", "cartpole_task.js", "vector_run.js")
@@ -40,7 +39,7 @@ def learner_sources() -> str:
     str
         Script text; under Node, ``require`` of a file holding it returns ``safepgLearner``.
     """
-    kernel = resources.files("safepg.thesis.explorers").joinpath("static", WASM_KERNEL).read_bytes()
+    kernel = static_bytes(WASM_KERNEL)
     text = "\n".join(static_text(name) for name in LEARNER_FILES)
     return text.replace(WASM_PLACEHOLDER, base64.b64encode(kernel).decode("ascii"), 1)
 
