@@ -10,7 +10,7 @@
 # "externally-managed-environment"), and an editable install into one shared interpreter
 # re-points every other clone on the machine to this clone's safepg.
 #
-# Reused as it is when requirements.txt, pyproject.toml and the interpreter are those of the
+# Reused as it is when requirements.txt, pyproject.toml, the version and the interpreter are those of the
 # last install (a stamp in the venv records their hash): a second `make book` installs
 # nothing. The venv is made anew when PYTHON names another interpreter than the one it was
 # made from, or when it no longer runs (its interpreter was removed).
@@ -63,8 +63,10 @@ if [ ! -x "$vpy" ]; then
   "$base" -m venv "$venv"
 fi
 
-# What the install depends on: the pins, the package's metadata and the venv's interpreter.
-inputs=$( { cat requirements.txt pyproject.toml; base_of "$vpy"; } | sha256sum | cut -d' ' -f1)
+# What the install depends on: the pins, the package's metadata (its version is read from
+# safepg/__init__.py) and the venv's interpreter.
+inputs=$( { cat requirements.txt pyproject.toml; grep '^__version__' safepg/__init__.py 2>/dev/null || true; base_of "$vpy"; } \
+  | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$inputs" ]; then
   rm -f "$stamp"  # an interrupted install is redone next time
   start=$SECONDS
