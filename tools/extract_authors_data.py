@@ -118,10 +118,11 @@ def table52(m: Mirror, manifest: dict) -> None:
             sources.append(m.source(path, "iteration N theta alpha J(closed form) J_hat",
                                     {"estimator": est, "bound": bound, "empirical_range": er, "delta": delta,
                                      "run": run}))
-            table += [[str(i), r[1], r[5]] for r in rows(m.read(path).decode())]
-    write("table52.csv.xz", ["source", "N", "J_hat"], table,
-          "Table 5.2 (and Figures 5.3-5.4): Algorithm 4.1 on the 1-D LQG from theta = 0, 3*10^7 trajectories; "
-          "batch size and measured (discounted) return of every iteration, 5 runs per row (1 for Bernstein e.r.).",
+            table += [[str(i), r[1], r[2], r[4], r[5]] for r in rows(m.read(path).decode())]
+    write("table52.csv.xz", ["source", "N", "theta", "J", "J_hat"], table,
+          "Table 5.2 (and Figures 5.1-5.4): Algorithm 4.1 on the 1-D LQG from theta = 0, 3*10^7 trajectories; "
+          "batch size, theta before the update, the closed-form J at it and the measured (discounted) return of "
+          "every iteration, 5 runs per row (1 for Bernstein e.r.).",
           sources, manifest)
 
 
@@ -142,14 +143,16 @@ def figures51_52(m: Mirror, manifest: dict) -> None:
     for stem, est, bound, er, delta in names:
         path = f"processed_data/{stem}.txt"
         i = len(sources)
-        sources.append(m.source(path, "trajectory performance (5-run mean of the closed-form J on a 1000-trajectory "
-                                      "grid)", {"estimator": est, "bound": bound, "empirical_range": er,
-                                                "delta": delta}))
+        sources.append(m.source(path, "trajectory performance (the closed-form J of their run 1 on a 1000-trajectory "
+                                      "grid, plots/scaleData.m)", {"estimator": est, "bound": bound,
+                                                                    "empirical_range": er, "delta": delta}))
         body = m.read(path).decode().splitlines()[1:]  # one header line, no blank line
         table += [[str(i), *line.split()] for line in body if line.strip()]
     write("figures51_52.csv.xz", ["source", "trajectories", "J"], table,
-          "Figures 5.1-5.2: the authors' plotted curves, the 5-run mean of the closed-form J of the policy in use "
-          "after every 1000 trajectories.", sources, manifest)
+          "Figures 5.1-5.2: the authors' plotted curves. Each is one run, their run 1 (sample1) of the row, mapped "
+          "by plots/scaleData.m onto a grid of 1000 trajectories: at x = 1000 (i + 1) the closed-form J of the "
+          "policy that collected the last batch ended before 1000 i trajectories (not a 5-run mean).",
+          sources, manifest)
 
 
 #: The 2-D runs: (key, path, the theta-free copy it must agree with).

@@ -23,7 +23,9 @@ The rules their plot scripts used, applicable to their runs and to ours:
 - :func:`truncated_average`: each run averaged over its first T iterations, T the shortest
   run of the row, and a 90% Student-t interval over runs (Table 5.2, ``plots/lqg.m``);
 - :func:`budget_average`: only the batches that end before a trajectory budget (Table 5.4,
-  ``plots/plot_cartpole.m``).
+  ``plots/plot_cartpole.m``);
+- :func:`grid_curve`: one run's values on a grid of trajectories, one update behind (Figures
+  5.1-5.2, ``plots/scaleData.m``).
 
 :func:`table_5_1` ... :func:`table_5_4` recompute the printed tables from the authors' files
 with those rules. :func:`lqg2d_performance` is the 2-D closed form their code evaluates:
@@ -159,7 +161,9 @@ def table51_runs() -> dict[tuple[float, int, float], AuthorsRun]:
 
 def table52_runs() -> dict[tuple[str, str, bool, float], list[AuthorsRun]]:
     """The runs of Table 5.2 by (estimator, bound, empirical range, delta), five per row (one for
-    Bernstein with empirical range, the only one committed): columns ``N`` and ``J_hat`` (the
+    Bernstein with empirical range, the only one committed), in the order of their ``run`` key
+    (the file's ``sample`` number): columns ``N`` (the batch collected at that iteration),
+    ``theta`` (before the update), ``J`` (the closed form at ``theta``) and ``J_hat`` (the
     batch's mean discounted return)."""
     out: dict[tuple[str, str, bool, float], list[AuthorsRun]] = {}
     for r in _runs("table52.csv.xz"):
@@ -168,10 +172,31 @@ def table52_runs() -> dict[tuple[str, str, bool, float], list[AuthorsRun]]:
     return out
 
 
+def table52_settings() -> dict[tuple[str, str, bool, float], dict[str, int]]:
+    """The batch limits each row of Table 5.2 ran with, from its run files' header line
+    (``N_min N_max delta estimator bound total``, written by ``lqg/lqg_adabatch.py@eb78917:161``),
+    by (estimator, bound, empirical range, delta): ``n_min``, ``n_max`` and ``total``.
+
+    Raises
+    ------
+    ValueError
+        If the runs of one row were written with different headers.
+    """
+    out = {}
+    for key, runs in table52_runs().items():
+        headers = {r.source["header"] for r in runs}
+        if len(headers) != 1:
+            raise ValueError(f"the runs of {key} have different headers: {sorted(headers)}")
+        n_min, n_max, _, _, _, total = headers.pop().split()
+        out[key] = {"n_min": int(n_min), "n_max": int(n_max), "total": int(total)}
+    return out
+
+
 def figure51_52_curves() -> dict[tuple[str, str, bool, float], AuthorsRun]:
     """The curves of Figures 5.1-5.2 as the authors plotted them, by (estimator, bound, empirical
-    range, delta): columns ``trajectories`` (1000, 2000, ...) and ``J`` (mean of 5 runs of the
-    closed-form J of the policy in use)."""
+    range, delta): columns ``trajectories`` (1000, 2000, ..., 30 001 000) and ``J``, written with 6
+    decimals. Each is one run, their run 1 of the row, through :func:`grid_curve` (not the
+    caption's mean of 5 runs)."""
     return {(r.key["estimator"], r.key["bound"], r.key["empirical_range"], r.key["delta"]): r
             for r in _runs("figures51_52.csv.xz")}
 
@@ -222,6 +247,54 @@ def cartpole_theta_star() -> np.ndarray:
 
 
 # ------------------------------------------------------------------ their rules
+#: Figures 5.1-5.2's grid: ``scaleData(batchsize, performance, 30000000, 1000)``
+#: (``plots/save_scaledData.m@5810ee6:5``).
+FIGURES_51_52_TOTAL = 30_000_000
+FIGURES_51_52_STEP = 1000
+
+
+def grid_curve(batch_size: np.ndarray, values: np.ndarray, total: int = FIGURES_51_52_TOTAL,
+               step: int = FIGURES_51_52_STEP) -> tuple[np.ndarray, np.ndarray]:
+    r"""A run's per-iteration values on the authors' trajectory grid, as ``plots/scaleData.m`` maps them.
+
+    Their Figures 5.1-5.2 are this map of one run file each (``plots/save_scaledData.m@5810ee6:1-11``,
+    ``plots/scaleData.m@e4cdc9e:1-11``): for :math:`i = 0, \dots, 	ext{total}/	ext{step}`,
+
+    .. math::
+        n_i = 	ext{step}\; i, \qquad j_i = \maxig(1,\ \#\{k : N_1 + \dots + N_k < n_i\}ig), \qquad
+        z_i = y_{j_i}, \quad 	ext{drawn at } x_i = 	ext{step}\,(i + 1),
+
+    with :math:`N_k` the batch collected at iteration :math:`k` and :math:`y_k` its logged value. Their
+    J column is the closed form at the parameter that collected batch :math:`k`, so at :math:`n`
+    trajectories the curve shows the policy of the last batch that *ended* before :math:`n`, one
+    update behind the policy collecting trajectory :math:`n`, and it is drawn one step to the right
+    (:math:`x = n + 	ext{step}`). Past the run's last batch the last value is held.
+
+    Parameters
+    ----------
+    batch_size : array_like, shape (I,)
+        The batch of each iteration.
+    values : array_like, shape (I,)
+        The value logged at each iteration (for the authors' J and ours: ``record.J[:-1]``).
+    total, step : int
+        The grid's end (in trajectories) and spacing.
+
+    Returns
+    -------
+    x, z : ndarray, shape (total / step + 1,)
+        The grid's x (int64) and the values there.
+    """
+    n = np.asarray(batch_size, dtype=float)
+    y = np.asarray(values, dtype=float)
+    if n.ndim != 1 or n.size == 0 or y.shape != n.shape:
+        raise ValueError(f"values must have the shape of batch_size, a non-empty (I,), got {y.shape} and {n.shape}")
+    if total % step:
+        raise ValueError(f"total must be a multiple of step, got total={total}, step={step}")
+    i = np.arange(total // step + 1, dtype=np.int64)
+    finished = np.searchsorted(np.cumsum(n), step * i, side="left")  # batches whose running total is < n_i
+    return step * (i + 1), y[np.maximum(finished, 1) - 1]
+
+
 def strict_improvement_ratio(values: np.ndarray) -> float:
     """Share of strict increases between consecutive values, over (len - 1) comparisons.
 
@@ -412,7 +485,8 @@ def lqg2d_performance(theta: np.ndarray, sigma: float = 1.0, gamma: float = LQG2
     return -4 * b2 * (b2 / 3 * float(portable.trace(P)) + W)
 
 
-__all__ = ["DATA_DIR", "REPOSITORY", "TABLE_5_4_BUDGET", "AuthorsRun", "budget_average", "cartpole_runs",
-           "cartpole_theta_star", "figure51_52_curves", "lqg2d_performance", "lqg2d_runs", "lqg2d_theta_ends",
-           "manifest", "strict_improvement_ratio", "table51_runs", "table52_runs", "table_5_1", "table_5_2",
-           "table_5_3", "table_5_4", "truncated_average", "verify_data"]
+__all__ = ["DATA_DIR", "FIGURES_51_52_STEP", "FIGURES_51_52_TOTAL", "REPOSITORY", "TABLE_5_4_BUDGET", "AuthorsRun",
+           "budget_average", "cartpole_runs", "cartpole_theta_star", "figure51_52_curves", "grid_curve",
+           "lqg2d_performance", "lqg2d_runs", "lqg2d_theta_ends", "manifest", "strict_improvement_ratio",
+           "table51_runs", "table52_runs", "table52_settings", "table_5_1", "table_5_2", "table_5_3", "table_5_4",
+           "truncated_average", "verify_data"]
