@@ -9,6 +9,7 @@ from safepg.thesis.analysis import (
     markdown_table,
     mean_band,
     measured_on_grid,
+    one_cell_spread,
     performance_on_grid,
     table_5_2,
     table_upsilon,
@@ -123,3 +124,21 @@ def test_comparison_figures_draw_the_seed_means():
     recs["a"][0].alpha[:] = [1e-3, 1e-4]
     fig = figure_5_6(recs, {"a": "A"})
     np.testing.assert_array_equal(fig.axes[0].get_lines()[0].get_ydata(), [1e-3, 1e-4])
+
+
+def test_one_cell_spread_by_hand():
+    def run(J, theta):
+        r = rec([10] * (len(J) - 1), J)
+        r.theta[:, 0] = theta
+        return r
+
+    # Two runs: 2 and 1 strict increases in 3 updates; theta crosses -0.5 after 2 and after 1 updates.
+    runs = [run([1.0, 2.0, 3.0, 2.0, 0.0], [-0.2, -0.4, -0.6, -0.7, -0.8]),
+            run([1.0, 2.0, 2.0, 1.0, 0.0], [-0.2, -0.6, -0.7, -0.8, -0.9])]
+    s = one_cell_spread(runs, 1.0, np.array([-0.1, -0.2, -0.3, -0.6]), -0.5)
+    np.testing.assert_allclose(s["ratios"], [2 / 3, 1 / 3])
+    assert s["mean"] == pytest.approx(0.5) and s["sd"] == pytest.approx(np.std([2 / 3, 1 / 3], ddof=1))
+    assert s["at_least"] == 0 and s["z"] == pytest.approx(0.5 / s["sd"])
+    assert s["crossing"].tolist() == [2, 1] and s["crossing_theirs"] == 3
+    with pytest.raises(ValueError, match="^records "):
+        one_cell_spread(runs[:1], 1.0, np.array([-0.1]), -0.5)

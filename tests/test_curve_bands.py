@@ -173,3 +173,44 @@ def test_rows_threshold_and_sentence() -> None:
     assert rows[1]["outside"] == ("leaves it on 2 ranges of iterations: 1–50.5 (by up to 3, 1.5 half-widths); "
                                   "60 (by up to 1, ∞ half-widths).")
     assert curve_score_rows([good])[0]["id"] == "figure-5.7/adaptive"
+
+
+def test_figures_51_52_under_the_authors_processing() -> None:
+    """Seeds made of their own run 1 (with tiny noise), stored as our runs under their settings: their
+    curve, which is that run through scaleData.m, lies inside the band for one run at every point; held
+    as the text reads it (the policy in use, against the band for a five-run mean), the same seeds are
+    one update ahead of it and leave it."""
+    key = ("gpomdp", "chebyshev", False, 0.75)
+    name = "gpomdp-chebyshev-delta=0.75"
+    run1 = authors.table52_runs()[key][0]
+    rng = np.random.default_rng(5)
+    recs = [_fake(run1["N"].copy(), np.append(run1["J"], run1["J"][-1]) + rng.normal(0, 1e-4, run1.iterations + 1))
+            for _ in range(5)]
+    records = {"table-5.2": {name: recs}, "figures-5.1-5.2-authors": {name: recs}}
+    scores = {s.processing: s for s in curve_scores(records) if "/run-" not in s.curve}
+    theirs, text = scores["authors"], scores["text"]
+    assert (theirs.kind, theirs.experiment, theirs.points) == ("one run", "figures-5.1-5.2-authors", 30_001)
+    assert theirs.share_inside > 0.99  # a band of 5 noisy seeds: a few points where s happens to be small
+    assert (text.kind, text.experiment) == ("mean of 5 runs", "table-5.2") and text.share_inside < 0.5
+    ids = [r["id"] for r in curve_score_rows([text, theirs])]
+    assert ids == [f"figure-5.1/{name}/table-5.2", f"figure-5.1/{name}/figures-5.1-5.2-authors/authors-processing"]
+    # Without runs under their settings, only the text's score.
+    assert {s.processing for s in curve_scores({"table-5.2": {name: recs}})} == {"text"}
+
+
+def test_hypotheses_and_spread_of_figures_51_52() -> None:
+    from safepg.thesis.curve_bands import FIGURES_51_52_HYPOTHESES, figures51_52_hypotheses, figures51_52_spread
+
+    key, name = ("gpomdp", "chebyshev", False, 0.75), "gpomdp-chebyshev-delta=0.75"
+    runs = authors.table52_runs()[key]
+    # Our five "seeds" are their five runs: run 1 is then inside the band of runs 1-5 under their processing.
+    recs = [_fake(r["N"].copy(), np.append(r["J"], r["J"][-1])) for r in runs]
+    records = {"table-5.2": {name: recs}, "figures-5.1-5.2-authors": {name: recs}}
+    rows = {h["curve"]: h for h in figures51_52_hypotheses(records)}
+    assert set(rows[name]) == {"curve"} | {h.label for h in FIGURES_51_52_HYPOTHESES}
+    assert rows[name][FIGURES_51_52_HYPOTHESES[-1].label] == 1.0  # their run 1 is one of the seeds
+    assert math.isnan(rows["gpomdp-chebyshev-delta=0.95"][FIGURES_51_52_HYPOTHESES[0].label])  # no runs
+    spread = {s["curve"]: s for s in figures51_52_spread(records)}
+    assert set(spread) == {name} and len(spread[name]["theirs"]) == 5 and len(spread[name]["ours"]) == 5
+    assert spread[name]["theirs"] == [1.0] * 5  # each of their runs is one of the seeds
+    assert all(0.0 <= v <= 1.0 for v in spread[name]["ours"])

@@ -31,7 +31,7 @@ BOOK_PAGES = {"preliminaries", "adaptive_step", "adaptive_batch", "lqg1d", "lqg2
 
 def tiny_experiments() -> dict:
     exps = {n: scaled(get_experiment(n), seeds=2, budget=4000) for n in sc.NEEDED}
-    for n in ("table-5.1", "table-5.1-printed-theta0", "table-5.1-authors"):
+    for n in ("table-5.1", "table-5.1-printed-theta0", "table-5.1-authors", "table-5.1-authors-tail"):
         # >= twice its largest batch: the authors' count needs two batch starts.
         exps[n] = scaled(get_experiment(n), seeds=2, budget=20_000)
     for n in sc.RANGE_VARIANTS:
@@ -39,7 +39,7 @@ def tiny_experiments() -> dict:
             exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
         except ValueError:  # not defined by this version of the library
             continue
-    for n in ("table-5.2-authors", "table-5.3-authors"):
+    for n in ("table-5.2-authors", "figures-5.1-5.2-authors", "table-5.3-authors"):
         exps[n] = scaled(get_experiment(n), seeds=2, budget=4000)
     for n in ("cartpole-baseline", "cartpole-baseline-authors"):
         exps[n] = scaled(get_experiment(n), seeds=2, budget=8000)

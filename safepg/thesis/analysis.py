@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from safepg.learning import LearningRecord
+from safepg.thesis.authors import strict_improvement_ratio
 
 
 def performance_on_grid(records: Sequence[LearningRecord], grid: np.ndarray) -> np.ndarray:
@@ -289,3 +290,38 @@ def simulated_objective(env: Any, sigma: float, lo: float, hi: float, points: in
 
     grid = np.linspace(lo, hi, points)
     return CubicSpline(grid, simulated_performance(env, grid, sigma, n, seed))
+
+
+def one_cell_spread(records: Sequence[LearningRecord], printed: float, theirs_theta: np.ndarray,
+                    theta_star: float) -> dict[str, Any]:
+    """Where one printed improvement ratio (one run of the authors') lies among many of our runs of a
+    Table 5.1 cell, counted as the authors counted (strict increases of J between batch starts), and
+    when theta crosses the optimum in their run and in ours (updates improve J while theta moves
+    towards theta*, so the crossing sets most of the ratio).
+
+    Parameters
+    ----------
+    records : sequence of LearningRecord
+        Our runs of the cell (at least two).
+    printed : float
+        The printed ratio.
+    theirs_theta : array_like
+        Their run's theta before each update.
+    theta_star : float
+        The optimum the runs start above.
+
+    Returns
+    -------
+    dict
+        ``ratios`` (ours), ``mean``, ``sd`` (one run's), ``at_least`` (our runs reaching the print),
+        ``z`` (the print in our standard deviations above our mean; NaN if our runs agree),
+        ``crossing`` (the updates after which each of our runs is past theta*) and ``crossing_theirs``.
+    """
+    if len(records) < 2:
+        raise ValueError(f"records must hold at least two runs, got {len(records)}")
+    ratios = np.array([strict_improvement_ratio(r.J[:-1]) for r in records])
+    mean, sd = float(ratios.mean()), float(ratios.std(ddof=1))
+    return {"ratios": ratios, "mean": mean, "sd": sd, "at_least": int(np.sum(ratios >= printed)),
+            "z": (printed - mean) / sd if sd > 0 else float("nan"),
+            "crossing": np.array([int(np.argmax(r.theta[:, 0] < theta_star)) for r in records]),
+            "crossing_theirs": int(np.argmax(np.asarray(theirs_theta) < theta_star))}

@@ -28,7 +28,8 @@ from safepg.thesis.experiments import get_experiment, make_env
 #: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
 CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
     "lqg1d": ("table-5.1", "table-5.1-printed-theta0", "table-5.1-no-baseline", "table-5.2",
-              "table-5.2-lemma-range", "table-5.2-raw-score", "table-5.1-authors", "table-5.2-authors"),
+              "table-5.2-lemma-range", "table-5.2-raw-score", "table-5.1-authors", "table-5.2-authors",
+              "figures-5.1-5.2-authors", "table-5.1-authors-tail"),
     "lqg2d": ("figures-5.5-5.6", "table-5.3", "table-5.3-authors"),
     "cartpole": tuple(dict.fromkeys(("cartpole-baseline", "table-5.4", "cartpole-baseline-authors", "table-5.4-authors",
                                      "table-5.4-authors-theta-star", *baseline_experiments(), "cartpole-sweep"))),

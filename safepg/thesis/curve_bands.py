@@ -6,14 +6,20 @@ seeds predict for a curve of its kind, at the authors' own x-values:
 
 - a single run (Figures 5.3-5.9) is held against the 95% prediction band of one run,
   :math:`\bar x \pm t_{0.975,\,k-1}\, s\sqrt{1 + 1/k}`;
-- a mean over :math:`n` runs (Figures 5.1-5.2, :math:`n = 5`) against the band of such a mean,
-  :math:`\bar x \pm t_{0.975,\,k-1}\, s\sqrt{1/n + 1/k}`;
+- a mean over :math:`n` runs (Figures 5.1-5.2 as the caption has them, :math:`n = 5`) against the
+  band of such a mean, :math:`\bar x \pm t_{0.975,\,k-1}\, s\sqrt{1/n + 1/k}`;
 
 with :math:`\bar x` and :math:`s` the mean and sample standard deviation of our :math:`k`
 seeds at that x (:func:`safepg.stats.prediction_band95`). The score is the share of the
 authors' points inside the band, the x-ranges where their curve leaves it and by how much.
 Only the plotted range counts (where ours exists; Figure 5.9 up to Table 5.4's budget);
 points there with fewer than two seeds have no band and are counted apart.
+
+Figures 5.1-5.2 are scored twice, each time with one processing for every curve
+(:data:`~safepg.thesis.overlays.PROCESSINGS`): as the thesis's text has them (the J of the policy in
+use, a five-run mean, on ``table-5.2``), and as the authors' plot script made them (one run through
+:func:`~safepg.thesis.authors.grid_curve`, on our runs under their settings:
+``figures-5.1-5.2-authors``, and ``table-5.2-authors`` for the two theoretical-range rows).
 
 The curves are the overlays' own (their series functions), against the experiment each figure
 draws: ``table-5.2`` (Figures 5.1-5.4), ``figures-5.5-5.6``, ``table-5.3`` and
@@ -27,7 +33,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,8 +47,11 @@ from safepg.thesis.experiments import get_experiment
 #: The scorecard's rule: a curve is reproduced when at least this share of it lies in our band.
 CURVE_SHARE = 0.9
 #: The experiments whose runs the scored figures draw (load these for :func:`curve_scores`).
-CURVE_EXPERIMENTS = ("table-5.2", "figures-5.5-5.6", "table-5.3", "table-5.3-authors", "table-5.4",
-                     "table-5.4-authors-theta-star")
+CURVE_EXPERIMENTS = ("table-5.2", "figures-5.1-5.2-authors", "table-5.2-authors", "figures-5.5-5.6", "table-5.3",
+                     "table-5.3-authors", "table-5.4", "table-5.4-authors-theta-star")
+#: Our runs of Figures 5.1-5.2 under the authors' settings, in the order looked up: a config's runs are
+#: taken from the first of these that has them.
+FIGURES_51_52_AUTHORS = ("figures-5.1-5.2-authors", "table-5.2-authors")
 #: Ranges listed by :func:`outside_sentence` before "and n more".
 LISTED_RANGES = 3
 #: How the authors' files write their numbers: Figures 5.1-5.2's curves with 6 decimals
@@ -87,6 +96,9 @@ class CurveScore:
         half-width (inf where the band has width 0).
     x_unit : str
         ``"trajectories"`` or ``"iterations"``.
+    processing : str
+        How their curve and ours were made from runs: ``"text"`` (as the thesis says; every figure) or
+        ``"authors"`` (their plot script's, Figures 5.1-5.2: :func:`~safepg.thesis.authors.grid_curve`).
     """
 
     figure: str
@@ -102,6 +114,7 @@ class CurveScore:
     share_inside: float
     outside: tuple[tuple[float, float, float, float], ...]
     x_unit: str
+    processing: str = "text"
 
 
 # ------------------------------------------------------------------ scoring one curve
@@ -194,11 +207,11 @@ def _kind(runs: int) -> str:
 
 def _score(figure: str, curve: str, quantity: str, where: str, source: str, experiment: str, runs: int,
            x_unit: str, x: np.ndarray, theirs: np.ndarray, ours: np.ndarray, x_max: float | None = None,
-           rounding: np.ndarray | float | None = None) -> CurveScore:
+           rounding: np.ndarray | float | None = None, processing: str = "text") -> CurveScore:
     rounding = written_rounding(theirs, digits=RUN_DIGITS) if rounding is None else rounding
     s = band_share(x, theirs, ours, runs, x_max, rounding)
     return CurveScore(figure, curve, quantity, where, source, experiment, _kind(runs), s["seeds"], s["points"],
-                      s["without_band"], s["share_inside"], s["outside"], x_unit)
+                      s["without_band"], s["share_inside"], s["outside"], x_unit, processing)
 
 
 def _pad(theirs: np.ndarray, ours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -211,33 +224,143 @@ def _pad(theirs: np.ndarray, ours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return padded, padded_ours
 
 
-def _lqg1d_scores(recs: Mapping[str, Sequence[LearningRecord]]) -> list[CurveScore]:
-    """Figures 5.1-5.2 (the authors' five-run means of J) and 5.3-5.4 (each of their runs' batch
-    sizes) against ``table-5.2``."""
+#: What Figures 5.1-5.2's curves plot under each processing (:data:`~safepg.thesis.overlays.PROCESSINGS`).
+FIGURES_51_52_QUANTITY = {
+    "text": "J(θ) of the policy in use (closed form), every 1000 trajectories",
+    "authors": "J(θ) of the policy of the last batch ended 1000 trajectories before x (closed form; their "
+               "scaleData.m), every 1000 trajectories",
+}
+
+
+def figures51_52_authors_runs(records: Records, name: str) -> tuple[str, Sequence[LearningRecord]] | None:
+    """Our runs of the Figure 5.1-5.2 curve ``name`` under the authors' settings: the first experiment
+    of :data:`FIGURES_51_52_AUTHORS` that has them, and the runs (None if none has)."""
+    for exp in FIGURES_51_52_AUTHORS:
+        recs = records.get(exp, {}).get(name)
+        if recs:
+            return exp, recs
+    return None
+
+
+def figures51_52_score(records: Mapping[str, Sequence[LearningRecord]], cfg: Any, experiment: str,
+                       processing: overlays.Processing) -> CurveScore:
+    """One curve of Figures 5.1-5.2 held against our band under ``processing`` (the runs of ``records``
+    for ``cfg``, an experiment's config of Table 5.2's rows)."""
+    error = cfg.method.error
+    key = (cfg.method.gradient.estimator, error.bound, error.empirical_range, error.delta)
+    both = error.bound == "chebyshev" and cfg.method.gradient.estimator == "gpomdp" and error.delta == 0.95
+    figure = "5.1" if error.bound == "chebyshev" else "5.2"
+    where = "Figures 5.1 and 5.2" if both else f"Figure {figure}"
+    s = overlays.figure51_52_overlay_series(records, cfg, processing)
+    return _score(figure, cfg.name, FIGURES_51_52_QUANTITY[processing], where,
+                  _source(authors.figure51_52_curves()[key]), experiment, s["runs"], "trajectories", s["x"],
+                  s["authors"], s["values"], rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS),
+                  processing=processing)
+
+
+class Hypothesis(NamedTuple):
+    """One way of holding the authors' curves of Figures 5.1-5.2 against ours, each choice explicit."""
+
+    label: str
+    processing: overlays.Processing
+    runs: int
+    settings: str  # "text" (table-5.2) or "authors" (:func:`figures51_52_authors_runs`)
+
+
+#: The ways tested, one choice changed at a time from the thesis's text to the authors' processing and
+#: settings (the scorecard decides on the first and the last; the others say which choice matters).
+FIGURES_51_52_HYPOTHESES = (
+    Hypothesis("the thesis's text: J of the policy in use, a five-run mean", "text", 5, "text"),
+    Hypothesis("their curve is one run: J of the policy in use", "text", 1, "text"),
+    Hypothesis("one run through their scaleData.m, our runs of the text", "authors", 1, "text"),
+    Hypothesis("J of the policy in use, one run, our runs under their settings", "text", 1, "authors"),
+    Hypothesis("their processing and settings: one run through scaleData.m, our runs under their settings",
+               "authors", 1, "authors"),
+)
+
+
+def figures51_52_hypotheses(records: Records) -> list[dict[str, Any]]:
+    """Each curve of Figures 5.1-5.2 under each of :data:`FIGURES_51_52_HYPOTHESES`: the share of the
+    authors' curve inside our band.
+
+    Returns
+    -------
+    list of dict
+        One per curve: ``curve`` (the config's name) and one share per hypothesis label (NaN where the
+        runs it needs are not stored).
+    """
+    text = records.get("table-5.2", {})
+    out = []
+    for cfg in get_experiment("table-5.2").configs:
+        row: dict[str, Any] = {"curve": cfg.name}
+        theirs = figures51_52_authors_runs(records, cfg.name)
+        for h in FIGURES_51_52_HYPOTHESES:
+            recs, c = (text.get(cfg.name), cfg) if h.settings == "text" else (
+                (theirs[1], get_experiment(theirs[0]).config(cfg.name)) if theirs else (None, cfg))
+            if not recs:
+                row[h.label] = math.nan
+                continue
+            s = overlays.figure51_52_overlay_series({cfg.name: recs}, c, h.processing, runs=h.runs)
+            row[h.label] = band_share(s["x"], s["authors"], s["values"], h.runs,
+                                      rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS))["share_inside"]
+        out.append(row)
+    return out
+
+
+def figures51_52_spread(records: Records) -> list[dict[str, Any]]:
+    """How far one run's share scatters, under the authors' processing and settings: each of their
+    committed runs of a curve of Figures 5.1-5.2 against our band for one run, and each of our seeds
+    against the band of our other seeds (one run drawn from our own process, judged by the same rule).
+
+    Returns
+    -------
+    list of dict
+        One per curve with our runs under their settings: ``curve``, ``theirs`` (the share of each
+        of their runs, run 1 first: the plotted one) and ``ours`` (each of our seeds' share).
+    """
+    runs52 = authors.table52_runs()
+    out = []
+    for cfg in get_experiment("table-5.2").configs:
+        found = figures51_52_authors_runs(records, cfg.name)
+        if found is None:
+            continue
+        error = cfg.method.error
+        key = (cfg.method.gradient.estimator, error.bound, error.empirical_range, error.delta)
+        s = overlays.figure51_52_overlay_series({cfg.name: found[1]}, cfg, "authors")
+        mapped = [authors.grid_curve(r["N"], r["J"])[1] for r in runs52[key]]
+        theirs = [band_share(s["x"], z, s["values"], 1, rounding=written_rounding(z, digits=RUN_DIGITS))["share_inside"]
+                  for z in mapped]
+        out.append({"curve": cfg.name, "theirs": theirs, "ours": own_spread(s["x"], s["values"])})
+    return out
+
+
+def _lqg1d_scores(records: Records) -> list[CurveScore]:
+    """Figures 5.1-5.2 (the authors' curves of J, under each processing) and 5.3-5.4 (each of their
+    runs' batch sizes) against ``table-5.2``, and Figures 5.1-5.2 under the authors' processing against
+    our runs under their settings (:func:`figures51_52_authors_runs`)."""
     exp = get_experiment("table-5.2")
-    curves, runs52 = authors.figure51_52_curves(), authors.table52_runs()
+    recs = records.get("table-5.2", {})
+    runs52 = authors.table52_runs()
     scores = []
     for cfg in exp.configs:
-        if cfg.name not in recs or not recs[cfg.name]:
-            continue
+        if recs.get(cfg.name):
+            scores.append(figures51_52_score(recs, cfg, exp.name, "text"))
+        theirs = figures51_52_authors_runs(records, cfg.name)
+        if theirs is not None:
+            name, mine = theirs
+            scores.append(figures51_52_score({cfg.name: mine}, get_experiment(name).config(cfg.name), name,
+                                             "authors"))
         estimator, error = cfg.method.gradient.estimator, cfg.method.error
-        key = (estimator, error.bound, error.empirical_range, error.delta)
-        both = error.bound == "chebyshev" and estimator == "gpomdp" and error.delta == 0.95
-        figure = "5.1" if error.bound == "chebyshev" else "5.2"
-        where = "Figures 5.1 and 5.2" if both else f"Figure {figure}"
-        s = overlays.figure51_52_overlay_series(recs, cfg)
-        scores.append(_score(figure, cfg.name, "J(θ) of the policy in use (closed form), every 1000 trajectories",
-                             where, _source(curves[key]), exp.name, overlays.FIGURES_51_52_RUNS, "trajectories",
-                             s["x"], s["authors"],
-                             s["values"], rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS)))
-        if not (estimator == "gpomdp" and error.delta == 0.95):
+        if not (recs.get(cfg.name) and estimator == "gpomdp" and error.delta == 0.95):
             continue
+        key = (estimator, error.bound, error.empirical_range, error.delta)
         figure, where = ("5.3", "Figures 5.3 and 5.4") if error.bound == "chebyshev" else ("5.4", "Figure 5.4")
         ours = by_iteration(recs[cfg.name], "batch_size")
         for run in runs52.get(key, []):
-            theirs, mine = _pad(np.asarray(run["N"], dtype=float), ours)
+            theirs_n, mine_n = _pad(np.asarray(run["N"], dtype=float), ours)
             scores.append(_score(figure, f"{cfg.name}/run-{run.key['run']}", "batch size N per iteration", where,
-                                 _source(run), exp.name, 1, "iterations", np.arange(1, theirs.size + 1), theirs, mine))
+                                 _source(run), exp.name, 1, "iterations", np.arange(1, theirs_n.size + 1), theirs_n,
+                                 mine_n))
     return scores
 
 
@@ -253,6 +376,36 @@ def _held_score(figure: str, curve: str, quantity: str, experiment: str, run: Au
                   theirs, ours, rounding=written_rounding(written, digits=RUN_DIGITS) / overlays.LQG2D_AUTHORS_SCALE)
 
 
+def figure55_series(run: AuthorsRun, recs: Sequence[LearningRecord]) -> dict[str, np.ndarray]:
+    """A curve of Figure 5.5 as the authors' plot script made it (``plots/plot_lqg2d.m@4ff60e7:8-20``,
+    ``plots/plot_scaledData2.m@4ff60e7:1-8``): their run's J (÷ 16) and each of our seeds through
+    :func:`~safepg.thesis.authors.grid_curve`, on their grid of 1000 trajectories; ``rounding`` is half a
+    unit of their written J, in our units."""
+    scale = overlays.LQG2D_AUTHORS_SCALE
+    x, written = authors.grid_curve(run["N"], run["J"])
+    ours = np.array([authors.grid_curve(r.batch_size, r.J[:-1])[1] for r in recs])
+    return {"x": x, "theirs": written / scale, "values": ours,
+            "rounding": written_rounding(written, digits=RUN_DIGITS) / scale}
+
+
+def figure55_spread(records: Records) -> list[dict[str, Any]]:
+    """:func:`figures51_52_spread` for Figure 5.5 (their one committed run of each step rule)."""
+    runs, step = authors.lqg2d_runs(), records.get("figures-5.5-5.6", {})
+    out = []
+    for key in ("scalar", "coordinate"):
+        if step.get(key):
+            g = figure55_series(runs[key], step[key])
+            theirs = band_share(g["x"], g["theirs"], g["values"], 1, rounding=g["rounding"])["share_inside"]
+            out.append({"curve": key, "theirs": [theirs], "ours": own_spread(g["x"], g["values"])})
+    return out
+
+
+def own_spread(x: np.ndarray, ours: np.ndarray) -> list[float]:
+    """Each of our seeds held, as one run, against the band for one run of our other seeds: how far the
+    share of a curve drawn from our own process scatters under the rule (``ours``: (seeds, points))."""
+    return [band_share(x, ours[i], np.delete(ours, i, axis=0), 1)["share_inside"] for i in range(ours.shape[0])]
+
+
 def _lqg2d_scores(records: Records) -> list[CurveScore]:
     """Figures 5.5-5.8 against ``figures-5.5-5.6``, ``table-5.3`` and ``table-5.3-authors``."""
     runs = authors.lqg2d_runs()
@@ -263,6 +416,13 @@ def _lqg2d_scores(records: Records) -> list[CurveScore]:
     if all(step.get(k) for k in ("scalar", "coordinate")):
         for key in ("scalar", "coordinate"):
             scores.append(_held_score("5.5", key, j_held, "figures-5.5-5.6", runs[key], step[key]))
+            # As their plot script made it: their guard (stop the run when eps >= |g|) never fires, in
+            # their runs or ours, so our runs are theirs in law and only the processing changes.
+            g = figure55_series(runs[key], step[key])
+            scores.append(_score("5.5", key, f"J(θ) (closed form; theirs ÷ {scale:g}) of the policy of the last batch "
+                                 "ended 1000 trajectories before x (their scaleData.m)", "Figure 5.5",
+                                 _source(runs[key]), "figures-5.5-5.6", 1, "trajectories", g["x"], g["theirs"],
+                                 g["values"], rounding=g["rounding"], processing="authors"))
         s = overlays.lqg2d_iteration_series("alpha", {k: step[k] for k in ("scalar", "coordinate")},
                                             {k: runs[k] for k in ("scalar", "coordinate")})
         for key in ("scalar", "coordinate"):
@@ -328,7 +488,7 @@ def curve_scores(records: Records) -> list[CurveScore]:
     -------
     list of CurveScore
     """
-    scores = _lqg1d_scores(records.get("table-5.2", {})) + _lqg2d_scores(records) + _cartpole_scores(records)
+    scores = _lqg1d_scores(records) + _lqg2d_scores(records) + _cartpole_scores(records)
     return sorted(scores, key=lambda s: tuple(int(p) for p in s.figure.split(".")))
 
 
@@ -367,21 +527,28 @@ def curve_score_rows(scores: Sequence[CurveScore]) -> list[dict[str, Any]]:
     ``points``, ``points_without_band``, ``experiment``, ``source``.
 
     The id is ``figure-<figure>/<curve>``, followed by ``/<experiment>`` when one curve of a
-    figure is held against several experiments.
+    figure is held against several experiments, and by ``/authors-processing`` when it is held as
+    the authors' plot script made it (``processing``: ``"text"`` or ``"authors"``).
     """
-    counts: dict[tuple[str, str], int] = {}
+    experiments: dict[tuple[str, str], set[str]] = {}
     for s in scores:
-        counts[(s.figure, s.curve)] = counts.get((s.figure, s.curve), 0) + 1
+        experiments.setdefault((s.figure, s.curve), set()).add(s.experiment)
     rows = []
     for s in scores:
-        ident = f"figure-{s.figure}/{s.curve}" + (f"/{s.experiment}" if counts[(s.figure, s.curve)] > 1 else "")
+        several = len(experiments[(s.figure, s.curve)]) > 1
+        ident = (f"figure-{s.figure}/{s.curve}" + (f"/{s.experiment}" if several else "")
+                 + ("/authors-processing" if s.processing == "authors" else ""))
         share = "no band" if s.points == 0 else f"{s.share_inside:.1%} of {s.points} points"
         rows.append({"id": ident, "quantity": s.quantity, "where": s.where, "share": share,
                      "share_inside": s.share_inside, "holds": curve_holds(s), "outside": outside_sentence(s),
                      "kind": s.kind, "seeds": s.seeds, "points": s.points,
-                     "points_without_band": s.points_without_band, "experiment": s.experiment, "source": s.source})
+                     "points_without_band": s.points_without_band, "experiment": s.experiment, "source": s.source,
+                     "processing": s.processing})
     return rows
 
 
-__all__ = ["CURVE_EXPERIMENTS", "CURVE_SHARE", "CurveScore", "band_share", "curve_holds", "curve_score_rows",
-           "curve_scores", "outside_sentence", "written_rounding"]
+__all__ = ["CURVE_EXPERIMENTS", "CURVE_SHARE", "FIGURES_51_52_AUTHORS", "FIGURES_51_52_HYPOTHESES",
+           "FIGURES_51_52_QUANTITY", "CurveScore", "Hypothesis", "band_share", "curve_holds", "curve_score_rows",
+           "curve_scores", "figures51_52_authors_runs", "figures51_52_hypotheses", "figures51_52_score",
+           "figures51_52_spread", "figure55_series", "figure55_spread", "own_spread",
+           "outside_sentence", "written_rounding"]

@@ -30,8 +30,14 @@ from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, car
 T51_OVERLAY_CELLS = ((0.5, 1000, 1e-3), (0.5, 1000, 1e-4), (1.0, 1000, 1e-3), (1.0, 1000, 1e-4))
 
 
-#: Runs behind each of the authors' curves of Figures 5.1-5.2 (their plotted five-run means, MANIFEST.json).
+#: Runs each curve of Figures 5.1-5.2 averages by the caption ("averaged over 5 runs"). Their plotted
+#: curves are one run each (:func:`safepg.thesis.authors.grid_curve`), hence the two processings.
 FIGURES_51_52_RUNS = 5
+#: How a run becomes a curve of Figures 5.1-5.2: as the thesis's text has it (the J of the policy
+#: collecting trajectory T, a five-run mean), or as the authors' plot script did (their one run
+#: through :func:`safepg.thesis.authors.grid_curve`).
+Processing = Literal["text", "authors"]
+PROCESSINGS: tuple[Processing, ...] = ("text", "authors")
 
 
 def seed_band95(values: np.ndarray, runs: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -144,24 +150,40 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
     return fig
 
 
-def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config) -> dict[str, np.ndarray]:
-    """One curve of Figures 5.1-5.2: ours (seed mean and 95% prediction band for a five-run mean of the
-    closed-form J of the
-    policy that generated trajectory T; ``values``, each seed's) and the authors' five-run mean,
-    on their grid of T."""
+def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config,
+                               processing: Processing = "text", runs: int | None = None) -> dict[str, np.ndarray]:
+    """One curve of Figures 5.1-5.2 on the authors' grid of T: ours (``values``, each seed's curve; their
+    mean and 95% prediction band) and the authors' plotted curve.
+
+    ``processing="text"``: each seed's closed-form J of the policy that generated trajectory T
+    (:func:`~safepg.thesis.analysis.performance_on_grid`), the band for a five-run mean (the caption).
+    ``processing="authors"``: each seed through the authors' :func:`~safepg.thesis.authors.grid_curve`
+    (their ``scaleData.m``), the band for one run, as their curve is. ``runs`` sets the band's number
+    of runs otherwise (to test one choice at a time).
+    """
+    if processing not in PROCESSINGS:
+        raise ValueError(f"processing must be one of {PROCESSINGS}, got {processing!r}")
     error = config.method.error
     curve = authors.figure51_52_curves()[(config.method.gradient.estimator, error.bound, error.empirical_range,
                                           error.delta)]
     grid = curve["trajectories"].astype(np.int64)
-    values = performance_on_grid(records[config.name], grid)
-    mean, lo, hi = seed_band95(values, runs=FIGURES_51_52_RUNS)
-    return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"], "values": values}
+    if processing == "text":
+        values, n = performance_on_grid(records[config.name], grid), FIGURES_51_52_RUNS
+    else:
+        mapped = [authors.grid_curve(r.batch_size, r.J[:-1]) for r in records[config.name]]
+        if any(not np.array_equal(x, grid) for x, _ in mapped):
+            raise ValueError(f"{config.name}: the authors' grid is not grid_curve's")
+        values, n = np.array([z for _, z in mapped]), 1
+    runs = n if runs is None else runs
+    mean, lo, hi = seed_band95(values, runs=runs)
+    return {"x": grid, "ours_mean": mean, "ours_lo": lo, "ours_hi": hi, "authors": curve["J"], "values": values,
+            "runs": runs}
 
 
 def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
-                       colors: Mapping[str, str], labels: Mapping[str, str]) -> None:
+                       colors: Mapping[str, str], labels: Mapping[str, str], processing: Processing) -> None:
     for c in configs:
-        s = figure51_52_overlay_series(records, c)
+        s = figure51_52_overlay_series(records, c, processing)
         ax.plot(s["x"], s["ours_mean"], color=colors[c.name], linewidth=1.6, label=labels[c.name])
         ax.fill_between(s["x"], s["ours_lo"], s["ours_hi"], color=colors[c.name], alpha=0.25, linewidth=0)
         # Theirs on top, thin: the two curves mostly coincide.
@@ -172,10 +194,13 @@ def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningReco
 
 
 def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
-                       ylim: tuple[float, float] | None = None) -> Figure:
-    """Figure 5.1 (Chebyshev, each delta): our ``table-5.2`` runs (mean and 95% prediction band for a
-    five-run mean over
-    seeds, in colour) under the authors' five-run means (black, dashed); one panel per estimator."""
+                       ylim: tuple[float, float] | None = None, processing: Processing = "text") -> Figure:
+    """Figure 5.1 (Chebyshev, each delta): our runs (mean and 95% prediction band over seeds, in colour)
+    under the authors' curves (black, dashed); one panel per estimator.
+
+    ``processing`` (:func:`figure51_52_overlay_series`): ``"text"`` draws the band for a five-run mean of
+    the J of the policy in use, ``"authors"`` the band for one run through their ``scaleData.m``.
+    """
     estimators = [e for e in ("gpomdp", "reinforce") if any(c.method.gradient.estimator == e for c in configs)]
     fig, axes = plt.subplots(1, len(estimators), figsize=(7, 3.6), squeeze=False, sharey=True)
     deltas = sorted({c.method.error.delta for c in configs})
@@ -183,7 +208,7 @@ def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs:
         mine = [c for c in configs if c.method.gradient.estimator == est]
         delta = {c.name: c.method.error.delta for c in mine}
         _figure51_52_panel(ax, records, mine, {n: plotting.delta_color(d, deltas) for n, d in delta.items()},
-                           {n: f"δ = {d}" for n, d in delta.items()})
+                           {n: f"δ = {d}" for n, d in delta.items()}, processing)
         ax.set_title(plotting.ESTIMATOR_LABELS[est], fontsize="small")
         if ylim is not None:
             ax.set_ylim(*ylim)
@@ -192,14 +217,14 @@ def figure_5_1_overlay(records: Mapping[str, Sequence[LearningRecord]], configs:
 
 
 def figure_5_2_overlay(records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
-                       ylim: tuple[float, float] | None = None) -> Figure:
-    """Figure 5.2 (G(PO)MDP, delta = 0.95, each bound): our ``table-5.2`` runs (mean and 95%
-    prediction band for a five-run mean, in colour) under the authors' five-run means (black, dashed)."""
+                       ylim: tuple[float, float] | None = None, processing: Processing = "text") -> Figure:
+    """Figure 5.2 (G(PO)MDP, delta = 0.95, each bound): our runs (mean and 95% prediction band, in colour)
+    under the authors' curves (black, dashed); ``processing`` as in :func:`figure_5_1_overlay`."""
     fig, ax = plt.subplots(figsize=(7, 3.8))
     errors = {c.name: c.method.error for c in configs}
     _figure51_52_panel(ax, records, configs,
                        {n: plotting.bound_color(e.bound, e.empirical_range) for n, e in errors.items()},
-                       {n: plotting.bound_label(e.bound, e.empirical_range) for n, e in errors.items()})
+                       {n: plotting.bound_label(e.bound, e.empirical_range) for n, e in errors.items()}, processing)
     if ylim is not None:
         ax.set_ylim(*ylim)
     fig.tight_layout()

@@ -1,6 +1,7 @@
 """Rows of the authors' whole curves (Figures 5.1-5.9): the share of each that lies in our pointwise 95%
 prediction band (:mod:`safepg.thesis.curve_bands`), on our runs of the thesis's text and on our runs under
-the authors' settings, as two columns of one row.
+the authors' settings (for Figures 5.1-5.2 also under their plot script's processing), as two columns of
+one row.
 
 An authors' figure of several runs of theirs (Figures 5.3-5.4: each of their committed runs drawn as one
 run) is one row: it holds when every run's curve does, and shows the range of their shares."""
@@ -11,7 +12,17 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from safepg.learning import LearningRecord
-from safepg.thesis.curve_bands import CURVE_SHARE, CurveScore, curve_holds, curve_scores, outside_sentence
+from safepg.thesis.curve_bands import (
+    CURVE_SHARE,
+    FIGURES_51_52_HYPOTHESES,
+    CurveScore,
+    curve_holds,
+    curve_scores,
+    figure55_spread,
+    figures51_52_hypotheses,
+    figures51_52_spread,
+    outside_sentence,
+)
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.outputs import Output
 
@@ -37,6 +48,33 @@ AUTHORS_NOTES = {
            "unguarded steps, their coordinate 'vanilla'.",
 }
 AUTHORS_NOTES["5.8"] = AUTHORS_NOTES["5.7"]
+AUTHORS_NOTES["5.1"] = AUTHORS_NOTES["5.2"] = (
+    "Reproduced with the authors' processing and settings, the same for every curve: each of their curves is "
+    "one run (their run 1, not a mean of 5) mapped by plots/scaleData.m@e4cdc9e:1-11 (at x, the J of the policy "
+    "of the last batch ended before x − 1000), and their script updates after the first batch whatever ε is "
+    "(lqg/lqg_adabatch.py@eb78917:212-222) with N_min and N_max from each run's header.")
+
+
+def _side(s: CurveScore) -> str:
+    """Which column a score fills: the authors' (their settings or their processing) or ours."""
+    return "authors" if s.processing == "authors" or s.experiment in AUTHORS_SETTINGS else "ours"
+
+
+def hypotheses_sentence(tested: Mapping[str, Any]) -> str:
+    """The shares one curve of Figures 5.1-5.2 gave under each hypothesis tested, in one sentence."""
+    parts = [f"{h.label}, {tested[h.label]:.1%}" for h in FIGURES_51_52_HYPOTHESES if h.label in tested]
+    return "Tested, with the share of their curve inside our band: " + "; ".join(parts) + "."
+
+
+def spread_sentence(spread: Mapping[str, Any]) -> str:
+    """How one run's share scatters (:func:`~safepg.thesis.curve_bands.figures51_52_spread`), in one sentence."""
+    theirs = ", ".join(f"{v:.1%}" for v in spread["theirs"])
+    ours = spread["ours"]
+    runs = (f"their committed runs give {theirs} (run 1, the plotted one, first)" if len(spread["theirs"]) > 1
+            else f"their one committed run gives {theirs}")
+    return (f"Under their processing and settings, {runs}, and each of our {len(ours)} seeds against the band of "
+            f"the other {len(ours) - 1} gives {min(ours):.1%} to {max(ours):.1%}: one run's share scatters that "
+            "much under this rule.")
 
 
 def _curve_key(s: CurveScore) -> str:
@@ -70,10 +108,12 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         Loaded runs by experiment name (those of :data:`~safepg.thesis.curve_bands.CURVE_EXPERIMENTS`
         that are stored; a curve without runs gets no row).
     """
+    tested = {h["curve"]: h for h in figures51_52_hypotheses(records)}
+    spread = {("5.1" if "chebyshev" in h["curve"] else "5.2", h["curve"]): h for h in figures51_52_spread(records)}
+    spread |= {("5.5", h["curve"]): h for h in figure55_spread(records)}
     grouped: dict[tuple[str, str], dict[str, list[CurveScore]]] = {}
     for s in curve_scores(records):
-        side = "authors" if s.experiment in AUTHORS_SETTINGS else "ours"
-        grouped.setdefault((s.figure, _curve_key(s)), {}).setdefault(side, []).append(s)
+        grouped.setdefault((s.figure, _curve_key(s)), {}).setdefault(_side(s), []).append(s)
     for (figure, curve), sides in grouped.items():
         group, page, heading = FIGURE_PLACES[figure]
         ours, theirs = (_column(sides[k]) if k in sides else None for k in ("ours", "authors"))
@@ -81,12 +121,22 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         authors = AuthorsColumn() if theirs is None else AuthorsColumn(
             text=theirs["text"], value=theirs["share"], ok=theirs["holds"], seeds=theirs["seeds"],
             experiment=theirs["worst"].experiment, interval_text=theirs["band"], note=AUTHORS_NOTES.get(figure, ""))
-        remark = " ".join(f"{label}: their curve {outside_sentence(c['worst'])}"
-                          for label, c in (("Ours", ours), ("Under the authors' settings, ours", theirs))
+        processed = theirs is not None and theirs["worst"].processing == "authors"
+        label = "Under the authors' processing and settings, ours" if processed else "Under the authors' settings, ours"
+        remark = " ".join(f"{lab}: their curve {outside_sentence(c['worst'])}"
+                          for lab, c in (("Ours", ours), (label, theirs))
                           if c is not None and not c["holds"])
+        still_open = not any(c is not None and c["holds"] for c in (ours, theirs))
+        if still_open and figure in ("5.1", "5.2"):
+            remark += " " + hypotheses_sentence(tested[curve])
+        if still_open and (figure, curve) in spread:
+            remark += " " + spread_sentence(spread[(figure, curve)])
         runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
+        # What their curve is: under their processing, one run whatever the caption says.
+        kind = (f"{theirs['worst'].kind}, which the caption calls averaged over 5 runs" if processed
+                else first.kind)
         b.add(RowSpec(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
-              where=first.where, thesis=f"the authors' curve ({first.kind})",
+              where=first.where, thesis=f"the authors' curve ({kind})",
               ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],
               rule="curve-band", kind="whole curve", page=page, heading=heading,
               ours_value=None if ours is None else ours["share"],

@@ -1,12 +1,22 @@
 """What a scorecard row is judged on: the prediction interval for one run of a report's entry, the texts
-that name an interval, and why a run's improvement ratio carries no information."""
+that name an interval, why a run's improvement ratio carries no information, and where a printed run
+lies among many of ours."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from safepg.thesis.scorecard.rules import FROZEN_THETA, in_prediction
+import numpy as np
+
+from safepg.envs.lqg import LQG
+from safepg.learning import LearningRecord
+from safepg.stats import prediction_interval95
+from safepg.thesis import authors
+from safepg.thesis.analysis import one_cell_spread
+from safepg.thesis.experiments import Experiment
+from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction
+from safepg.thesis.scorecard.text import pct
 
 
 def prediction(d: Mapping[str, Any] | None, ratio: bool = False) -> list[float] | None:
@@ -75,3 +85,25 @@ def ratio_text(row: Mapping[str, Any] | None) -> str:
 def one_run_ratio(printed: float, row: Mapping[str, Any] | None) -> bool | None:
     """Rule ``"prediction"`` on an improvement ratio: the printed percentage in :func:`ratio_interval`."""
     return in_prediction(f"{100 * printed:.6g}", ratio_interval(row))
+
+
+def tail_placement(tail: Experiment | None, recs: Mapping[str, Sequence[LearningRecord]]
+                   ) -> dict[tuple[float, int, float], TailRuns]:
+    """Where the printed cell of ``tail`` (one Table 5.1 cell, many seeds under the authors' settings)
+    lies among our runs of it (``recs``: its runs by config): the note's values by cell (sigma, N,
+    alpha); empty without two runs that differ."""
+    cfg = None if tail is None else tail.single_config()
+    if cfg is None or len(recs.get(cfg.name, ())) < 2:
+        return {}
+    cell = (cfg.sigma, cfg.method.batch_size, cfg.method.step.alpha)
+    theta_star = float(LQG.thesis_1d().optimal_gain().ravel()[0])
+    s = one_cell_spread(recs[cfg.name], tail.thesis[cfg.name]["improvement_ratio"],
+                        authors.table51_runs()[cell]["theta"], theta_star)
+    if not np.isfinite(s["z"]):  # our runs all agree: no spread to place the print in
+        return {}
+    pi = prediction_interval95(s["ratios"])["pi95"]
+    c = s["crossing"]
+    return {cell: TailRuns(runs=len(recs[cfg.name]), mean=pct(s["mean"]), interval=f"[{pct(pi[0])}; {pct(pi[1])}]",
+                           at_least=s["at_least"], z=s["z"], theta_star=theta_star,
+                           crossing_theirs=s["crossing_theirs"],
+                           crossing_ours=f"{c.min()} to {c.max()} (mean {c.mean():.0f})")}

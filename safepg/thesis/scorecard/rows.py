@@ -26,8 +26,9 @@ RANGE_VARIANTS = ("table-5.2-lemma-range",)
 #: Ours under the authors' settings (their code's where the text says otherwise or nothing). Read
 #: from the store, never computed here (``python -m safepg run NAME`` computes them): rows whose
 #: runs are missing or partly stored show them without judging them.
-AUTHORS_VARIANTS = ("table-5.1-authors", "table-5.2-authors", "table-5.3-authors", "cartpole-baseline-authors",
-                    "table-5.4-authors", "table-5.4-authors-theta-star")
+AUTHORS_VARIANTS = ("table-5.1-authors", "table-5.1-authors-tail", "table-5.2-authors", "figures-5.1-5.2-authors",
+                    "table-5.3-authors", "cartpole-baseline-authors", "table-5.4-authors",
+                    "table-5.4-authors-theta-star")
 
 
 def _records(exp: Experiment, root: Path | None, run: bool, jobs: int) -> dict[str, list[LearningRecord]]:

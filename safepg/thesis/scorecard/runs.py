@@ -28,6 +28,7 @@ from safepg.thesis.scorecard.judged import (
     prediction,
     ratio_interval,
     ratio_text,
+    tail_placement,
 )
 from safepg.thesis.scorecard.rules import (
     FROZEN_THETA,
@@ -39,6 +40,7 @@ from safepg.thesis.scorecard.rules import (
     FinalTheta,
     MovedComponents,
     RangeRuns,
+    TailRuns,
     Theta0s,
     half_unit,
     in_prediction,
@@ -111,10 +113,11 @@ def _report_row(rep: Mapping[str, Any] | None, name: str) -> Mapping[str, Any] |
 
 def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed: Experiment,
                     printed_rep: Mapping[str, Any], authors: Experiment | None,
-                    authors_rep: Mapping[str, Any] | None) -> None:
-    """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the
-    authors' settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed
-    theta_0, found before their outputs were read) is quoted in the explanation."""
+                    authors_rep: Mapping[str, Any] | None,
+                    tail: Mapping[tuple[float, int, float], TailRuns] | None = None) -> None:
+    """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the authors'
+    settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed theta_0, found
+    before their outputs were read) is quoted in the explanation; ``tail`` places a print among ours."""
     recon = {_cell(c): r for c, r in zip(exp.configs, rep["configs"])}
     theirs = {_cell(c): r for c, r in zip(authors.configs if authors else (), (authors_rep or {}).get("configs", []))}
     starts = Theta0s(printed_theta0=f"{T51_PRINTED_THETA0:g}", authors_theta0=f"{AUTHORS_T51_THETA0:g}")
@@ -152,8 +155,8 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
                               "(where all 24 of their output files start), counted as they counted (strict increases "
                               "over 10^6/N - 1 updates), it is inside." + recon_text),
               slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
-              fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]},
-              output=out, note_values=starts))
+              fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]}, output=out,
+              note_id="table-5.1/tail" if key in (tail or {}) else None, note_values=(tail or {}).get(key, starts)))
 
 
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
@@ -577,7 +580,8 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
         Name of the Table 5.2 variant with Lemma 4.3.3's range, when the library defines it.
     """
     _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps["table-5.1-printed-theta0"],
-                    reps["table-5.1-printed-theta0"], exps.get("table-5.1-authors"), reps.get("table-5.1-authors"))
+                    reps["table-5.1-printed-theta0"], exps.get("table-5.1-authors"), reps.get("table-5.1-authors"),
+                    tail_placement(exps.get("table-5.1-authors-tail"), recs.get("table-5.1-authors-tail", {})))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
                     reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
