@@ -36,7 +36,8 @@ def test_manifest_matches_the_files() -> None:
     # Every row is there: the manifest's row counts against the loaded runs.
     loaded = {"table51.csv.xz": A.table51_runs().values(), "lqg2d.csv.xz": A.lqg2d_runs().values(),
               "cartpole.csv.xz": A.cartpole_runs().values(), "figures51_52.csv.xz": A.figure51_52_curves().values(),
-              "table52.csv.xz": [r for runs in A.table52_runs().values() for r in runs]}
+              "table52.csv.xz": [r for runs in A.table52_runs().values() for r in runs],
+              "figure55.csv.xz": A.figure55_curves().values()}
     for name, runs in loaded.items():
         assert sum(r.iterations for r in runs) == m["files"][name]["rows"], name
 

@@ -49,7 +49,8 @@ class Mirror:
         blob = self.git("rev-parse", f"{READ_AT}:{path}").decode().strip()
         commit = self.git("log", "-1", "--format=%H", READ_AT, "--", path).decode().strip()
         data = self.read(path)
-        header = data.decode().splitlines()[0] if not path.endswith(".npy") else "(NumPy .npy, 4 float64)"
+        header = (data.decode().splitlines()[0] if not path.endswith((".npy", ".fig"))
+                  else "(NumPy .npy, 4 float64)" if path.endswith(".npy") else "(MATLAB figure, a MAT-file)")
         return {"path": path, "commit": commit, "blob": blob, "bytes": len(data), "header": header,
                 "columns": columns, "key": key}
 
@@ -155,6 +156,38 @@ def figures51_52(m: Mirror, manifest: dict) -> None:
           sources, manifest)
 
 
+def figure_lines(data: bytes) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The plotted lines of a MATLAB ``.fig`` file (a MAT-file holding the figure's object tree):
+    each line's ``DisplayName`` and its ``XData``, ``YData``."""
+    import scipy.io
+
+    tree = scipy.io.loadmat(io.BytesIO(data), squeeze_me=True, struct_as_record=False)["hgS_070000"]
+    lines, todo = {}, [tree]
+    while todo:
+        node = todo.pop()
+        props = getattr(node, "properties", None)
+        if props is not None and hasattr(props, "YData") and hasattr(props, "DisplayName"):  # a line series
+            lines[str(props.DisplayName)] = (np.atleast_1d(props.XData).astype(float),
+                                             np.atleast_1d(props.YData).astype(float))
+        children = getattr(node, "children", None)
+        if children is not None:
+            todo.extend(np.atleast_1d(children).ravel())
+    return lines
+
+
+def figure55(m: Mirror, manifest: dict) -> None:
+    path = "plots/compare_stepsize.fig"
+    lines = figure_lines(m.read(path))
+    sources, table = [], []
+    for i, (key, name) in enumerate((("coordinate", "Non-scalar step size"), ("scalar", "Scalar step size"))):
+        x, y = lines[name]
+        sources.append(m.source(path, f"the line '{name}': XData YData", {"run": key}))
+        table += [[str(i), str(int(a)), repr(float(b))] for a, b in zip(x, y)]
+    write("figure55.csv.xz", ["source", "trajectories", "J"], table,
+          "Figure 5.5 as the authors plotted it: the two lines of their MATLAB figure (16 x the expectation), each "
+          "float64 written as its shortest exact decimal.", sources, manifest)
+
+
 #: The 2-D runs: (key, path, the theta-free copy it must agree with).
 LQG2D = [("adaptive", "lqgnd/results/adabatch_est1_bound5__delta0_95_sample1.out",
           "lqgnd/results/notheta/adabatch_theta0_sample1.out"),
@@ -226,7 +259,7 @@ def main(git_dir: str) -> None:
                 "note": "Columns keep the original text of every number; 'commit' is the last commit that changed "
                         "the source up to read_at, 'blob' its git object id, 'bytes' its size.",
                 "files": {}}
-    for part in (table51, table52, figures51_52, lqg2d, cartpole):
+    for part in (table51, table52, figures51_52, lqg2d, figure55, cartpole):
         part(m, manifest)
     (OUT / "MANIFEST.json").write_text(json.dumps(manifest, indent=1) + "\n")
     total = sum(f["bytes"] for f in manifest["files"].values())

@@ -13,6 +13,7 @@ Loaders (each number as the authors wrote it):
 - :func:`table52_runs`: the runs of Table 5.2 (batch size and measured return per iteration);
 - :func:`figure51_52_curves`: the curves of Figures 5.1-5.2 as the authors plotted them;
 - :func:`lqg2d_runs`: the 2-D LQG runs of Table 5.3 and Figures 5.5-5.8;
+- :func:`figure55_curves`: Figure 5.5 as the authors plotted it (their MATLAB figure's two lines);
 - :func:`cartpole_runs`, :func:`cartpole_theta_star`: the cart-pole runs of Table 5.4 and
   Figure 5.9, the baseline search and the baseline policy.
 
@@ -210,6 +211,13 @@ def lqg2d_runs() -> dict[str, AuthorsRun]:
     last parameters. Table 5.3's N = 100 run is not in the authors' repository.
     """
     return {r.key["run"]: r for r in _runs("lqg2d.csv.xz")}
+
+
+def figure55_curves() -> dict[str, AuthorsRun]:
+    """Figure 5.5 as the authors plotted it (``plots/compare_stepsize.fig@4ff60e7``, read from the MATLAB
+    figure): ``"coordinate"`` and ``"scalar"``, columns ``trajectories`` (1000, 2000, ..., 30 001 000) and
+    ``J`` (16 times the expectation); :func:`grid_curve` of their run gives it."""
+    return {r.key["run"]: r for r in _runs("figure55.csv.xz")}
 
 
 def lqg2d_theta_ends() -> dict[str, dict[str, Any]]:
@@ -486,7 +494,7 @@ def lqg2d_performance(theta: np.ndarray, sigma: float = 1.0, gamma: float = LQG2
 
 
 __all__ = ["DATA_DIR", "FIGURES_51_52_STEP", "FIGURES_51_52_TOTAL", "REPOSITORY", "TABLE_5_4_BUDGET", "AuthorsRun",
-           "budget_average", "cartpole_runs", "cartpole_theta_star", "figure51_52_curves", "grid_curve",
-           "lqg2d_performance", "lqg2d_runs", "lqg2d_theta_ends", "manifest", "strict_improvement_ratio",
+           "budget_average", "cartpole_runs", "cartpole_theta_star", "figure51_52_curves", "figure55_curves",
+           "grid_curve", "lqg2d_performance", "lqg2d_runs", "lqg2d_theta_ends", "manifest", "strict_improvement_ratio",
            "table51_runs", "table52_runs", "table52_settings", "table_5_1", "table_5_2", "table_5_3", "table_5_4",
            "truncated_average", "verify_data"]

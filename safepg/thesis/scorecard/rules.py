@@ -279,7 +279,7 @@ _FIGURES_5_1_5_2 = Note(
 _FIGURE_5_5_COORDINATE = Note(
     "Open: their coordinate run lies above our seeds' band over part of its course, read as the thesis's text "
     "reads it (each batch's J held at their batch ends) and as their plot script made it (plots/scaleData.m, one "
-    "update behind), which differ by at most a few thousandths; their step sizes lie in our band (Figure 5.6). "
+    "update behind), which differ by about a hundredth of J at most; their step sizes lie in our band (Figure 5.6). "
     "What is missing: their other runs (one run per step rule is committed), to tell a run ahead of ours from a "
     "difference of the method.", "lqg2d", "Figures 5.5 and 5.6", explains=False)
 
