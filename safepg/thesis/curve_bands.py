@@ -15,11 +15,12 @@ authors' points inside the band, the x-ranges where their curve leaves it and by
 Only the plotted range counts (where ours exists; Figure 5.9 up to Table 5.4's budget);
 points there with fewer than two seeds have no band and are counted apart.
 
-Figures 5.1-5.2 are scored twice, each time with one processing for every curve
+Figures 5.1, 5.2 and 5.5 are scored twice, each time with one processing for every curve
 (:data:`~safepg.thesis.overlays.PROCESSINGS`): as the thesis's text has them (the J of the policy in
-use, a five-run mean, on ``table-5.2``), and as the authors' plot script made them (one run through
-:func:`~safepg.thesis.authors.grid_curve`, on our runs under their settings:
-``figures-5.1-5.2-authors``, and ``table-5.2-authors`` for the two theoretical-range rows).
+use; Figures 5.1-5.2 a five-run mean, on ``table-5.2``), and as the authors' plot script made them (one
+run through :func:`~safepg.thesis.authors.grid_curve`, on our runs under their settings:
+``figures-5.1-5.2-authors``, ``table-5.2-authors`` for the two theoretical-range rows, and
+``figures-5.5-5.6``, whose settings are theirs).
 
 The curves are the overlays' own (their series functions), against the experiment each figure
 draws: ``table-5.2`` (Figures 5.1-5.4), ``figures-5.5-5.6``, ``table-5.3`` and
@@ -98,7 +99,7 @@ class CurveScore:
         ``"trajectories"`` or ``"iterations"``.
     processing : str
         How their curve and ours were made from runs: ``"text"`` (as the thesis says; every figure) or
-        ``"authors"`` (their plot script's, Figures 5.1-5.2: :func:`~safepg.thesis.authors.grid_curve`).
+        ``"authors"`` (their plot script's, Figures 5.1, 5.2 and 5.5: :func:`~safepg.thesis.authors.grid_curve`).
     """
 
     figure: str
@@ -232,6 +233,11 @@ FIGURES_51_52_QUANTITY = {
 }
 
 
+def _figure_51_52(error: Any) -> str:
+    """The figure that draws a curve of Table 5.2's rows: Chebyshev's in Figure 5.1, the other bounds' in 5.2."""
+    return "5.1" if error.bound == "chebyshev" else "5.2"
+
+
 def figures51_52_authors_runs(records: Records, name: str) -> tuple[str, Sequence[LearningRecord]] | None:
     """Our runs of the Figure 5.1-5.2 curve ``name`` under the authors' settings: the first experiment
     of :data:`FIGURES_51_52_AUTHORS` that has them, and the runs (None if none has)."""
@@ -249,7 +255,7 @@ def figures51_52_score(records: Mapping[str, Sequence[LearningRecord]], cfg: Any
     error = cfg.method.error
     key = (cfg.method.gradient.estimator, error.bound, error.empirical_range, error.delta)
     both = error.bound == "chebyshev" and cfg.method.gradient.estimator == "gpomdp" and error.delta == 0.95
-    figure = "5.1" if error.bound == "chebyshev" else "5.2"
+    figure = _figure_51_52(error)
     where = "Figures 5.1 and 5.2" if both else f"Figure {figure}"
     s = overlays.figure51_52_overlay_series(records, cfg, processing)
     return _score(figure, cfg.name, FIGURES_51_52_QUANTITY[processing], where,
@@ -315,8 +321,8 @@ def figures51_52_spread(records: Records) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        One per curve with our runs under their settings: ``curve``, ``theirs`` (the share of each
-        of their runs, run 1 first: the plotted one) and ``ours`` (each of our seeds' share).
+        One per curve with our runs under their settings: ``figure``, ``curve``, ``theirs`` (the share
+        of each of their runs, run 1 first: the plotted one) and ``ours`` (each of our seeds' share).
     """
     runs52 = authors.table52_runs()
     out = []
@@ -330,7 +336,8 @@ def figures51_52_spread(records: Records) -> list[dict[str, Any]]:
         mapped = [authors.grid_curve(r["N"], r["J"])[1] for r in runs52[key]]
         theirs = [band_share(s["x"], z, s["values"], 1, rounding=written_rounding(z, digits=RUN_DIGITS))["share_inside"]
                   for z in mapped]
-        out.append({"curve": cfg.name, "theirs": theirs, "ours": own_spread(s["x"], s["values"])})
+        out.append({"figure": _figure_51_52(error), "curve": cfg.name, "theirs": theirs,
+                    "ours": own_spread(s["x"], s["values"])})
     return out
 
 
@@ -396,7 +403,7 @@ def figure55_spread(records: Records) -> list[dict[str, Any]]:
         if step.get(key):
             g = figure55_series(runs[key], step[key])
             theirs = band_share(g["x"], g["theirs"], g["values"], 1, rounding=g["rounding"])["share_inside"]
-            out.append({"curve": key, "theirs": [theirs], "ours": own_spread(g["x"], g["values"])})
+            out.append({"figure": "5.5", "curve": key, "theirs": [theirs], "ours": own_spread(g["x"], g["values"])})
     return out
 
 

@@ -1,7 +1,7 @@
 """Rows of the authors' whole curves (Figures 5.1-5.9): the share of each that lies in our pointwise 95%
 prediction band (:mod:`safepg.thesis.curve_bands`), on our runs of the thesis's text and on our runs under
-the authors' settings (for Figures 5.1-5.2 also under their plot script's processing), as two columns of
-one row.
+the authors' settings (for Figures 5.1, 5.2 and 5.5 under their plot script's processing), as two columns
+of one row.
 
 An authors' figure of several runs of theirs (Figures 5.3-5.4: each of their committed runs drawn as one
 run) is one row: it holds when every run's curve does, and shows the range of their shares."""
@@ -48,6 +48,9 @@ AUTHORS_NOTES = {
            "unguarded steps, their coordinate 'vanilla'.",
 }
 AUTHORS_NOTES["5.8"] = AUTHORS_NOTES["5.7"]
+AUTHORS_NOTES["5.5"] = (
+    "Reproduced as the authors' plot script made it: their run through plots/scaleData.m@4ff60e7:1-11 (at x, the J "
+    "of the policy of the last batch ended before x − 1000), and each of our runs likewise.")
 AUTHORS_NOTES["5.1"] = AUTHORS_NOTES["5.2"] = (
     "Reproduced with the authors' processing and settings, the same for every curve: each of their curves is "
     "one run (their run 1, not a mean of 5) mapped by plots/scaleData.m@e4cdc9e:1-11 (at x, the J of the policy "
@@ -109,8 +112,7 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         that are stored; a curve without runs gets no row).
     """
     tested = {h["curve"]: h for h in figures51_52_hypotheses(records)}
-    spread = {("5.1" if "chebyshev" in h["curve"] else "5.2", h["curve"]): h for h in figures51_52_spread(records)}
-    spread |= {("5.5", h["curve"]): h for h in figure55_spread(records)}
+    spread = {(h["figure"], h["curve"]): h for h in figures51_52_spread(records) + figure55_spread(records)}
     grouped: dict[tuple[str, str], dict[str, list[CurveScore]]] = {}
     for s in curve_scores(records):
         grouped.setdefault((s.figure, _curve_key(s)), {}).setdefault(_side(s), []).append(s)
@@ -133,8 +135,8 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
             remark += " " + spread_sentence(spread[(figure, curve)])
         runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
         # What their curve is: under their processing, one run whatever the caption says.
-        kind = (f"{theirs['worst'].kind}, which the caption calls averaged over 5 runs" if processed
-                else first.kind)
+        kind = (f"{theirs['worst'].kind}, which the caption calls averaged over 5 runs"
+                if processed and figure in ("5.1", "5.2") else first.kind)
         b.add(RowSpec(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
               where=first.where, thesis=f"the authors' curve ({kind})",
               ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],
