@@ -17,12 +17,20 @@ export VIRTUAL_ENV := $(CURDIR)/.venv
 export JUPYTER_PATH := $(CURDIR)/.venv/share/jupyter
 export JUPYTER_PREFER_ENV_PATH := 1
 
-.PHONY: setup browser-deps lint test test-lib book book-assets bench lab wasm
+.PHONY: setup setup-dev browser-deps lint test test-lib book book-assets bench lab wasm dist
 
 # Creates .venv on first use (installing Debian's python3.X-venv as root if missing), reuses
 # it while requirements.txt and pyproject.toml are unchanged.
 setup:
 	@PYTHON_GIVEN=$(if $(filter command line environment override,$(origin PYTHON)),1) bash tools/setup_venv.sh "$(PYTHON)"
+
+# The tools of `make test` and `make dist` alone (requirements-dev.txt: build, check-wheel-contents),
+# on top of setup's venv; installed again when that file or setup's own install changes.
+setup-dev: setup
+	@h=$$(cat requirements-dev.txt .venv/.safepg-setup | sha256sum | cut -d' ' -f1); \
+	if [ "$$(cat .venv/.safepg-dev 2>/dev/null)" != "$$h" ]; then \
+	  $(VPY) -m pip install --quiet --disable-pip-version-check -r requirements-dev.txt && echo "$$h" > .venv/.safepg-dev \
+	  && echo "setup-dev: installed requirements-dev.txt into .venv"; fi
 
 # Debian's Chromium for the browser test (Playwright drives it; no browser download).
 browser-deps:
@@ -32,10 +40,10 @@ browser-deps:
 lint: setup
 	$(VPY) -m ruff check safepg tests benchmarks
 
-test: setup browser-deps lint
+test: setup setup-dev browser-deps lint
 	$(VPY) -m pytest
 
-test-lib: setup
+test-lib: setup setup-dev
 	$(VPY) -m pytest tests -m "not browser"
 
 # MathJax from the npm registry into book/_vendor (pages render math offline), and axe-core into
@@ -52,6 +60,11 @@ book: setup book-assets
 	bash book/tools/cache_guard.sh
 	$(VPY) -m safepg run-book
 	$(VBIN)/jupyter-book build . -W -n --keep-going
+
+# dist/: the sdist and the wheel (python -m build), the built book as safepg-book-<version>.tar.gz
+# (deterministic) and SHA256SUMS over them (tools/dist.sh).
+dist: setup-dev book
+	bash tools/dist.sh
 
 bench: setup
 	$(VPY) benchmarks/bench_iteration.py
