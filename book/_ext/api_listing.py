@@ -21,6 +21,12 @@ stays a missing reference (an error under ``-n -W``).
 The docstrings write an absolute value as in plain text, ``|r_t|``, which is how ``help()``
 shows them; to reStructuredText that is a substitution reference, an error when none is
 defined. Outside inline markup, such a ``|...|`` is shown here as the literal text it is.
+
+Each section's ``.. py:module::`` target is followed by the autosummary table, whose first node
+is a ``tabular_col_spec`` (the table's LaTeX column spec). Docutils' ``PropagateTargets``
+moves the target's id (``module-safepg.store``, where the module index and ``:mod:`` link)
+onto that next node, and the HTML writer skips it whole, id included. :class:`KeepTargetIds`
+moves such an id onto the table the spec belongs to, which the HTML writes.
 """
 
 from __future__ import annotations
@@ -31,6 +37,11 @@ import inspect
 import re
 from pathlib import Path
 from typing import Any
+
+from docutils import nodes
+from docutils.transforms import Transform
+from docutils.transforms.references import PropagateTargets
+from sphinx import addnodes
 
 #: The book's tables do not wrap (safepg-book.css keeps numbers on one line); an autosummary
 #: table's summaries must, and its names must not be broken letter by letter.
@@ -336,6 +347,31 @@ def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
     return None
 
 
+class KeepTargetIds(Transform):
+    """Move the ids a target gave a ``tabular_col_spec`` onto the table that follows it.
+
+    ``PropagateTargets`` hands a block-level target's ids to the next node, which is a
+    ``tabular_col_spec`` when an autosummary table (or ``.. tabularcolumns::``) comes next.
+    No HTML translator writes that node, so the id would be in the index and the links but
+    not in the page. The spec describes the next table: that table carries the ids instead.
+    """
+
+    default_priority = PropagateTargets.default_priority + 1
+
+    def apply(self, **kwargs: Any) -> None:
+        for spec in list(self.document.findall(addnodes.tabular_col_spec)):
+            if not spec["ids"]:
+                continue
+            table = spec.next_node(nodes.table, ascend=True)
+            if table is None:
+                continue
+            for key in ("ids", "names"):
+                table[key] = spec[key] + [v for v in table[key] if v not in spec[key]]
+                spec[key] = []
+            for node_id in table["ids"]:
+                self.document.ids[node_id] = table
+
+
 def setup(app: Any) -> dict[str, Any]:
     app.setup_extension("sphinx.ext.autodoc")
     app.setup_extension("sphinx.ext.autosummary")
@@ -344,4 +380,7 @@ def setup(app: Any) -> dict[str, Any]:
     # Before numpydoc (priority 500) turns the sections into reStructuredText.
     app.connect("autodoc-process-docstring", _docstring, priority=400)
     app.connect("missing-reference", _missing_reference)
-    return {"parallel_read_safe": True, "parallel_write_safe": True}
+    app.add_transform(KeepTargetIds)
+    # Doctrees read before KeepTargetIds existed lack the module ids: a new env_version has
+    # Sphinx read every page again instead of reusing them.
+    return {"parallel_read_safe": True, "parallel_write_safe": True, "env_version": 1}
