@@ -75,7 +75,7 @@ class ErrorBound:
 
 
 def reinforce_variance_factor(constants: TaskConstants) -> float:
-    r"""Bound on Var[REINFORCE sample] (Lemma 5.4 of [24], Section 4.3.1).
+    r"""Bound on Var[REINFORCE sample] (Lemma 5.4 of Pirotta et al. (2013), Section 4.3.1).
 
     .. math:: \frac{R^2 M_\phi^2 H (1-\gamma^H)^2}{\sigma^2 (1-\gamma)^2}
     """
@@ -86,7 +86,7 @@ def reinforce_variance_factor(constants: TaskConstants) -> float:
 
 
 def gpomdp_variance_factor(constants: TaskConstants) -> float:
-    r"""Bound on Var[G(PO)MDP sample] (Lemma 5.5 of [24], Section 4.3.1).
+    r"""Bound on Var[G(PO)MDP sample] (Lemma 5.5 of Pirotta et al. (2013), Section 4.3.1).
 
     .. math:: \frac{R^2 M_\phi^2}{\sigma^2(1-\gamma)^2}\Big[\frac{1-\gamma^{2H}}{1-\gamma^2}
               + H\gamma^{2H} - 2\gamma^H\frac{1-\gamma^H}{1-\gamma}\Big]

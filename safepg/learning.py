@@ -307,7 +307,7 @@ def vanilla_pg(
     With a :class:`~safepg.options.FixedStep`: :math:`\theta \leftarrow \theta +
     \alpha\hat\nabla J` (``kind="scalar"``) or only the largest component moves
     (``kind="coordinate"``). With a :class:`~safepg.options.SafeStep` the step is adaptive,
-    using the bound's eps at the fixed N: the scalar step of [24] (``"scalar"``) or the
+    using the bound's eps at the fixed N: the scalar step of Pirotta et al. (2013) (``"scalar"``) or the
     coordinate step Lambda* of Corollary 4.2.8 (``"coordinate"``), as compared in Section
     5.2.1 (Figures 5.5-5.6). A fixed step can make theta diverge until the gradient
     overflows: with ``stop_on_divergence=True`` the run then ends and the record says so

@@ -79,10 +79,10 @@ def guaranteed_improvement(g: float, eps: float, c: float) -> float:
 
 
 def scalar_step(grad: np.ndarray, eps: float, c: float) -> float:
-    r"""Adaptive scalar step size of Pirotta et al. [24] (Section 3.3.2), with estimation error.
+    r"""Adaptive scalar step size of Pirotta et al. (2013) (Section 3.3.2), with estimation error.
 
     Maximising :math:`\alpha\|\underline{\hat\nabla J}\|_2^2 - c\,\alpha^2\|\overline{\hat\nabla J}\|_1^2`
-    (the bound of [24] with the lower and upper gradient bounds of Section 4.2.2) gives
+    (the bound of Pirotta et al. (2013) with the lower and upper gradient bounds of Section 4.2.2) gives
 
     .. math:: \hat\alpha^* = \frac{\|\max(|\hat\nabla J| - \epsilon, 0)\|_2^2}
                                   {2c\,\||\hat\nabla J| + \epsilon\|_1^2}

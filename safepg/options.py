@@ -225,14 +225,14 @@ class FixedStep:
 class SafeStep:
     r"""The step that guarantees improvement with probability :math:`1 - \delta` at a fixed N.
 
-    ``kind="scalar"`` is the scalar step of [24]; ``"coordinate"`` the coordinate step
+    ``kind="scalar"`` is the scalar step of Pirotta et al. (2013); ``"coordinate"`` the coordinate step
     :math:`\Lambda^*` of Corollary 4.2.8 (Section 5.2.1 compares them, Figures 5.5-5.6). One
     :math:`\epsilon` serves all components: the largest per-component bound.
 
     Parameters
     ----------
     kind : {"scalar", "coordinate"}
-        The scalar step of [24] or the coordinate step.
+        The scalar step of Pirotta et al. (2013) or the coordinate step.
     error : ErrorModel
         The bound :math:`\epsilon` is computed with.
     """

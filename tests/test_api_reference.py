@@ -144,9 +144,12 @@ def built_page(tmp_path_factory: pytest.TempPathFactory) -> str:
     sphinx["config"]["html_static_path"] = [str(ROOT / p) for p in sphinx["config"]["html_static_path"]
                                             if (ROOT / p).is_dir()]
     (book / "_config.yml").write_text(yaml.safe_dump(config))
-    (book / "_toc.yml").write_text("format: jb-book\nroot: book/api\n")
+    # The References page and its bibliography: the docstrings' citations link there.
+    (book / "_toc.yml").write_text("format: jb-book\nroot: book/api\nchapters:\n- file: book/references\n")
     (book / "book").mkdir()
     shutil.copy(PAGE, book / "book" / "api.md")
+    shutil.copy(ROOT / "book" / "references.md", book / "book" / "references.md")
+    shutil.copy(ROOT / "references.bib", book / "references.bib")
     proc = subprocess.run([str(jb) if jb.exists() else "jupyter-book", "build", str(book), "-W", "-n",
                            "--keep-going"], capture_output=True, text=True, timeout=600)
     log = re.sub(r"\x1b\[[0-9;]*m", "", proc.stdout + proc.stderr)

@@ -4,7 +4,7 @@ Deterministic parts (same inputs, same outputs, to 1e-12 relative): the closed-f
 gradient, the gradient samples and returns of a batch fed safepg's own random numbers (relative
 to the largest sample of the component: the baseline's sums are added in another order), the
 bounds and steps of every option (constants, statistics, the unguarded step, the scalar step of
-[24] and the coordinate step at a fixed N), and whole runs fed safepg's random numbers.
+Pirotta et al. (2013) and the coordinate step at a fixed N), and whole runs fed safepg's random numbers.
 
 Stochastic parts: 30 seeds each side on four settings (among them the authors' adaptive run and
 the two fixed-N steps of Figures 5.5-5.6), the difference of the means inside its 99% Welch
@@ -352,7 +352,7 @@ SETTINGS: dict[str, tuple[Any, dict[str, Any]]] = {
         lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, budget=100_000, rng=s, **AUTHORS_OPTIONS),
         {"bound": "bernstein", "empiricalRange": True, "budget": 100_000, "nMax": 100_000, "statistics": "max",
          "stepWhenUnsafe": True}),
-    "scalar step of [24], N = 2000, 10^5": (
+    "scalar step of Pirotta et al. (2013), N = 2000, 10^5": (
         lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep("scalar"), budget=100_000,
                              rng=s),
         {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "scalar", "budget": 100_000}),

@@ -152,7 +152,8 @@ def test_kernel_twins_return_the_pages_structure(steps, adaptive):
     res = steps.compute_py({**steps.defaults(), "budget": "30000"})
     assert set(res["plots"]) == {"theta", "J"} and set(res["values"]) == {"scalar", "coordinate", "done"}
     assert [s["label"] for s in res["plots"]["theta"]["series"]] == [
-        "scalar step [24]: theta_11", "scalar step [24]: theta_22", "coordinate step: theta_11",
+        "scalar step (Pirotta et al. 2013): theta_11", "scalar step (Pirotta et al. 2013): theta_22",
+        "coordinate step: theta_11",
         "coordinate step: theta_22"]
     v = res["values"]["coordinate"]
     assert v["trajectories"] == 30_000 and v["theta_final"][0] < 0 and v["theta_final"][3] < 0

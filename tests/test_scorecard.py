@@ -452,7 +452,11 @@ def test_counts_and_html(rows):
     assert sum(c["all"].values()) == len(rows)
     assert sum(sum(v.values()) for g, v in c.items() if g != "all") == len(rows)
     page = sc.summary_html(rows) + "".join(sc.group_html(rows, g) for g in sc.GROUPS)
-    assert page.count("<tr class=\"sc-row\" data-id=") == len(rows)
+    assert page.count("<tr class=\"sc-row\" id=\"sc-") == len(rows)
+    # each row has its own anchor, which other pages (the front page) link to
+    assert len({sc.row_anchor(r.id) for r in rows}) == len(rows)
+    assert sc.row_anchor("section-5.2/J-star") == "sc-section-5.2-J-star"
+    assert sc.row_anchor("figure-5.1/gpomdp-chebyshev-delta=0.95") == "sc-figure-5.1-gpomdp-chebyshev-delta-0.95"
     judged = sum(r.judged_on == "authors' settings" for r in rows)
     assert judged and page.count('data-judged-on="authors&#x27; settings"') == judged
     assert all(s.replace("'", "&#x27;") in page for s in sc.STATUSES)

@@ -6,9 +6,9 @@ horizontal force on the cart in N, clipped to [-10, 10] before it is applied. Th
 is linear Gaussian, :math:`a \sim \mathcal N(\theta^\top s, \sigma^2)`, so the features are
 the state itself.
 
-Physics: the frictionless cart-pole of Barto, Sutton and Anderson (1983) with the
-equations of motion of Florian (2007, "Correct equations for the dynamics of the
-cart-pole system"), integrated with the explicit Euler scheme that gymnasium's
+Physics: the frictionless cart-pole of Barto et al. (1983) with the equations of motion
+of Florian (2007), "Correct equations for the dynamics of the cart-pole system", integrated
+with the explicit Euler scheme that gymnasium's
 ``CartPoleEnv`` uses (``kinematics_integrator = "euler"``: positions advance with the
 *old* velocities). The pole is a uniform rod hinged at its lower end, so its centre of
 mass sits at half its length and its moment of inertia about the centre is

@@ -12,7 +12,7 @@ Modules (all their public names are available here):
   their LaTeX names and :func:`latex`, and the helpers :func:`tidy`, :func:`is_zero`,
   :func:`maximise`;
 - :mod:`safepg.theory.step_size`: Section 4.2, the penalty constant, the improvement
-  bounds and Corollaries 4.2.4, 4.2.5 and 4.2.8, and the scalar step of [24]
+  bounds and Corollaries 4.2.4, 4.2.5 and 4.2.8, and the scalar step of Pirotta et al. (2013)
   (Sections 3.3.2, 5.2.1);
 - :mod:`safepg.theory.batch_size`: Section 4.3, :math:`\Upsilon_\delta`, Theorem 4.3.2 and
   the Chebyshev, Hoeffding and empirical Bernstein batch sizes;

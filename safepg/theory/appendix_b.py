@@ -16,7 +16,7 @@ from safepg.theory.symbols import A_vol, M_phi, R, alpha, b, c, g, gamma, maximi
 def softmax_constants() -> dict[str, sp.Expr]:
     r"""Theorem B.0.6: constants c and b for softmax policies.
 
-    Lemma 3.1 of [24] with Lemma B.0.4 (remainder :math:`\ge -6M_\varphi^2 D^2`,
+    Lemma 3.1 of Pirotta et al. (2013) with Lemma B.0.4 (remainder :math:`\ge -6M_\varphi^2 D^2`,
     :math:`D = \|\Lambda\nabla J\|_1`), Lemma B.0.5 (:math:`\|\pi'-\pi\|_\infty^2 \le 4M_\varphi D`),
     :math:`\sum_a|Q| \le |\mathcal A|R/(1-\gamma)` and :math:`\|Q\|_\infty \le R/(1-\gamma)`.
 

@@ -118,7 +118,7 @@ def chebyshev_d() -> dict[str, sp.Expr]:
 
 
 def chebyshev_n_star() -> dict[str, sp.Expr]:
-    r"""Section 4.3.1: explicit :math:`N^*` for REINFORCE and G(PO)MDP (Lemmas 5.4/5.5 of [24]).
+    r"""Section 4.3.1: explicit :math:`N^*` for REINFORCE and G(PO)MDP (Lemmas 5.4/5.5 of Pirotta et al. (2013)).
 
     The printed error bounds :math:`\epsilon \le \frac{1}{\sqrt N}(\dots)` give :math:`d_\delta`;
     substituting into :func:`theorem_4_3_2`'s :math:`N^*` gives the explicit batch sizes,

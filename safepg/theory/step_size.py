@@ -3,7 +3,7 @@ r"""Section 4.2: the adaptive step size (coordinate descent) of a Gaussian polic
 The penalty constant :math:`c` of Theorem 4.2.3 and its assembly from Lemma 4.2.2, the
 improvement bounds for one coordinate with an exact (Theorem 4.2.3) or estimated (Theorem
 4.2.6) gradient, their maximisers (Corollaries 4.2.4, 4.2.8), the comparison with the
-scalar step of [24] (Corollary 4.2.5, Sections 3.3.2 and 5.2.1) and why a single
+scalar step of Pirotta et al. (2013) (Corollary 4.2.5, Sections 3.3.2 and 5.2.1) and why a single
 coordinate is optimal among all diagonal steps.
 """
 
@@ -36,7 +36,7 @@ def penalty_constant() -> sp.Expr:
 def penalty_constant_derivation(remainder_factor: sp.Expr | int = 1) -> dict[str, sp.Expr]:
     r"""Assemble :math:`c` from the proof of Lemma 4.2.2 and Theorem 4.2.3 (Appendix A).
 
-    Lemma 3.1 of [24] has the penalties
+    Lemma 3.1 of Pirotta et al. (2013) has the penalties
     :math:`\frac{1}{1-\gamma}\int d_\mu\int(\pi'-\pi)Q` and
     :math:`\frac{\gamma}{2(1-\gamma)^2}\|\pi'-\pi\|_\infty^2\|Q\|_\infty`. Lemma A.0.1 bounds the
     Taylor remainder of :math:`\pi'-\pi` by :math:`K\,D^2`, :math:`K = M_\varphi^2/(\sqrt{2\pi}\sigma^3)`,
@@ -89,7 +89,7 @@ def improvement_bound_approx(
 
 
 def scalar_step_bound(alpha: sp.Expr = alpha) -> sp.Expr:
-    r"""Bound (3.7) of [24] for the scalar step :math:`\Lambda = \alpha I`:
+    r"""Bound (3.7) of Pirotta et al. (2013) for the scalar step :math:`\Lambda = \alpha I`:
     :math:`\alpha\|\nabla J\|_2^2 - c\,\alpha^2\|\nabla J\|_1^2`."""
     return alpha * g2**2 - c * alpha**2 * g1**2
 
@@ -171,7 +171,7 @@ def _corollary_4_2_5() -> dict[str, sp.Expr]:
 
 
 def corollary_4_2_5() -> dict[str, sp.Expr]:
-    r"""Corollary 4.2.5: coordinate step vs the scalar step of [24].
+    r"""Corollary 4.2.5: coordinate step vs the scalar step of Pirotta et al. (2013).
 
     The scalar bound :math:`\alpha\|g\|_2^2 - c\alpha^2\|g\|_1^2` is maximised at
     :math:`\alpha^* = \|g\|_2^2/(2c\|g\|_1^2)` with value :math:`\|g\|_2^4/(4c\|g\|_1^2)`. The
@@ -252,7 +252,7 @@ def coordinate_descent_reduction() -> dict[str, sp.Expr]:
 
 # --------------------------------------------------------------------------- Section 3.3.2 / 5.2.1
 def scalar_step_comparison() -> dict[str, sp.Expr]:
-    r"""Printed scalar step sizes of [24] vs :math:`\|g\|_2^2/(2c\|g\|_1^2)` with c of Theorem 4.2.3.
+    r"""Printed scalar step sizes of Pirotta et al. (2013) vs :math:`\|g\|_2^2/(2c\|g\|_1^2)` with c of Theorem 4.2.3.
 
     Returns
     -------

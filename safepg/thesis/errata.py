@@ -317,7 +317,7 @@ def _errata() -> tuple[Erratum, ...]:
         ),
         Erratum(
             "scalar_step_5_2_1",
-            "Section 5.2.1 (scalar step size of [24])",
+            "Section 5.2.1, scalar step size of Pirotta et al. (2013)",
             sc["printed_alpha_5_2_1"],
             sc["derived_alpha"],
             "The printed alpha-hat* has ||g/2||_2^2 = ||g||_2^2 / 4 (and an unbalanced parenthesis); Section 3.3.2 "
@@ -361,8 +361,8 @@ def _errata() -> tuple[Erratum, ...]:
         Erratum(
             "ref_assumption_3_1",
             "Appendix A, proof of Lemma A.0.1",
-            "Lemma 4.1 from [24] and Assumption 3.1",
-            "Lemma 4.1 from [24] and Assumption 4.2.1",
+            "Lemma 4.1 from Pirotta et al. (2013) and Assumption 3.1",
+            "Lemma 4.1 from Pirotta et al. (2013) and Assumption 4.2.1",
             "The feature bound is Assumption 4.2.1.",
             "no",
             "Cross-reference only.",
@@ -406,12 +406,13 @@ def _verified() -> tuple[Verified, ...]:
     return (
         Verified("thm_4_2_3_c", "Theorem 4.2.3 (constant c)",
                  penalty_constant(), penalty_constant_derivation()["c"],
-                 "penalty_constant_derivation: Lemma 3.1 of [24] + Lemmas A.0.1, A.0.2, |Q| <= R/(1-gamma)"),
+                 "penalty_constant_derivation: Lemma 3.1 of Pirotta et al. (2013) + Lemmas A.0.1, A.0.2, "
+                 "|Q| <= R/(1-gamma)"),
         Verified("cor_4_2_4_alpha", "Corollary 4.2.4", 1 / (2 * c), c424["alpha_star"], "maximise d/dalpha = 0"),
         Verified("cor_4_2_4_improvement", "Corollary 4.2.4",
                  g**2 / (4 * c), c424["improvement"],
                  "maximise; coordinate_descent_reduction for optimality over all diagonal Lambda >= 0"),
-        Verified("cor_4_2_5_scalar_step", "Corollary 4.2.5 / [24]",
+        Verified("cor_4_2_5_scalar_step", "Corollary 4.2.5 / Pirotta et al. (2013)",
                  g2**2 / (2 * c * g1**2), c425["scalar_alpha_star"],
                  "maximise alpha ||g||_2^2 - c alpha^2 ||g||_1^2"),
         Verified("cor_4_2_5_inequality", "Corollary 4.2.5",
@@ -453,10 +454,11 @@ def _verified() -> tuple[Verified, ...]:
         Verified("chebyshev_d", "Section 4.3.1", sp.sqrt(var / delta), cheb["d"], "chebyshev_d"),
         Verified("chebyshev_N_star_reinforce", "Section 4.3.1 (REINFORCE N*)",
                  cns["printed_N_star_reinforce"], cns["N_star_reinforce"],
-                 "N* of Theorem 4.3.2 with the printed d (consistency; [24]'s Lemma 5.4 itself not re-derived)"),
+                 "N* of Theorem 4.3.2 with the printed d (consistency; Lemma 5.4 of Pirotta et al. (2013) itself "
+                 "not re-derived)"),
         Verified("chebyshev_N_star_gpomdp", "Section 4.3.1 (G(PO)MDP N*)",
                  cns["printed_N_star_gpomdp"], cns["N_star_gpomdp"],
-                 "as above, Lemma 5.5 of [24]"),
+                 "as above, Lemma 5.5 of Pirotta et al. (2013)"),
         Verified("hoeffding_d", "Section 4.3.2", hd["printed_d"], hd["d"], "hoeffding_d (from the correct tail)"),
         Verified("bernstein_d_f", "Section 4.3.3",
                  "d = sqrt(2 S_N ln(3/delta)), f = 3 R ln(3/delta)",
@@ -467,10 +469,11 @@ def _verified() -> tuple[Verified, ...]:
             "Section 4.3.3 (S_N with 1/N)",
             r"S_N = \frac{1}{N}\sum_i (X_i - \bar X_N)^2",
             "the printed bound sqrt(2 S_N ln(3/delta)/N) + 3R ln(3/delta)/N is the empirical Bernstein bound of "
-            "Audibert, Munos & Szepesvari (2009, Thm 1) / Mnih, Szepesvari & Audibert (2008), stated with the "
-            "1/N sample variance; Maurer & Pontil's bound (unbiased variance) has ln(2/delta) and 7/(3(N-1))",
-            "literature comparison; the reference list is not in the extracted text, so [15]'s identity is "
-            "unchecked. Using ddof = 1 (SETTINGS.md) only enlarges d (conservative).",
+            "Audibert et al. (2009), Theorem 1, and of Mnih et al. (2008), stated with the 1/N sample variance; "
+            "the bound of Maurer and Pontil (2009) (unbiased variance) has ln(2/delta) and 7/(3(N-1))",
+            "literature comparison; the thesis's reference list is not in the extracted text, so its reference 15 "
+            "is identified as Mnih et al. (2008) from this bound's form and its place in the alphabetical list, "
+            "not from the list itself. Using ddof = 1 (SETTINGS.md) only enlarges d (conservative).",
             relation="supports",
         ),
         Verified("bernstein_N0", "Section 4.3.3 (N_0)", bn["printed_N_0"], bn["N_0"], "bernstein_n_zero"),
@@ -481,10 +484,10 @@ def _verified() -> tuple[Verified, ...]:
                  "one root", sp.Integer(bd["sign_changes"]),
                  "bernstein_descartes + bernstein_root_beyond_n_zero (the root exceeds N_0 and is the maximum)",
                  relation="supports"),
-        Verified("scalar_step_3_3_2", "Section 3.3.2 (alpha* of [24])",
+        Verified("scalar_step_3_3_2", "Section 3.3.2, alpha* of Pirotta et al. (2013)",
                  sc["printed_alpha_3_3_2"], sc["derived_alpha"],
                  "scalar_step_comparison: ratio 1"),
-        Verified("scalar_improvement_3_3_2", "Section 3.3.2 (improvement of [24])",
+        Verified("scalar_improvement_3_3_2", "Section 3.3.2, improvement of Pirotta et al. (2013)",
                  sc["printed_improvement_3_3_2"], sc["derived_improvement"],
                  "scalar_step_comparison: ratio 1"),
         Verified("bound_3_7", "Section 3.3.2, bound (3.7)",

@@ -227,8 +227,8 @@ def _figures_5_5_5_6() -> Experiment:
                               theta0=(0.0,) * 4) for kind in ("scalar", "coordinate"))
     thesis = {"scalar": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_SCALAR},
               "coordinate": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_COORDINATE}}
-    return Experiment("figures-5.5-5.6", "2-D LQG: the scalar adaptive step of [24] against the coordinate "
-                      "step Lambda* (G(PO)MDP, Chebyshev, delta = 0.95, N = 2000, 3*10^7 trajectories), "
+    return Experiment("figures-5.5-5.6", "2-D LQG: the scalar adaptive step of Pirotta et al. (2013) against the "
+                      "coordinate step Lambda* (G(PO)MDP, Chebyshev, delta = 0.95, N = 2000, 3*10^7 trajectories), "
                       "Figures 5.5-5.6.", configs, thesis=thesis)
 
 

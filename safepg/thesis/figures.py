@@ -143,7 +143,7 @@ def figure_comparison(records: Records, labels: Mapping[str, str], measured: boo
 
 def figure_5_6(records: Records, labels: Mapping[str, str]) -> Figure:
     r"""Figure 5.6: magnitude of the step size over iterations, the scalar
-    :math:`\hat\alpha^*` of [24] against :math:`\|\Lambda^*\|_\infty` (the coordinate
+    :math:`\hat\alpha^*` of Pirotta et al. (2013) against :math:`\|\Lambda^*\|_\infty` (the coordinate
     step moves one component, so its infinity norm is the recorded alpha)."""
     fig, ax = plt.subplots(figsize=(7, 4))
     for (name, label), col in zip(labels.items(), _COMPARISON_COLORS):

@@ -116,7 +116,7 @@ def check_lemma_a01_hessian(
     sigma_range: tuple[float, float] = (0.2, 3.0),
     n_grid: int = 20001,
 ) -> CheckResult:
-    r"""Lemma A.0.1 (via Lemma 4.1 of [24]):
+    r"""Lemma A.0.1 (via Lemma 4.1 of Pirotta et al. (2013)):
     :math:`|\partial^2\pi/\partial\theta_i\partial\theta_j| \le |\varphi_i\varphi_j|/(\sqrt{2\pi}\sigma^3)`.
 
     Checked (i) on a grid of :math:`z = (a-\mu)/\sigma \in [-10, 10]` (the sup of

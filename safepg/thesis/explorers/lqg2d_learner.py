@@ -1,6 +1,6 @@
 r"""Section 5.2 live: the 2-D LQG explorers, computed in the reader's browser (see :mod:`.ch5_live`).
 
-:func:`lqg2d_steps_explorer` (Figures 5.5-5.6): the scalar adaptive step of [24] against the
+:func:`lqg2d_steps_explorer` (Figures 5.5-5.6): the scalar adaptive step of Pirotta et al. (2013) against the
 coordinate step Lambda* (``vanilla_pg`` with ``SafeStep("scalar")``/``SafeStep("coordinate")``,
 a fixed N as ``figures-5.5-5.6`` configures it: G(PO)MDP, Chebyshev, delta = 0.95, N = 2000),
 drawing the diagonal gains theta_11 and theta_22 and J over the updates.
@@ -48,7 +48,7 @@ BUDGETS = (30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000, 30_000_00
 #: Entries of the flattened 2 x 2 gain drawn: the diagonal (the off-diagonal gains stay near 0).
 THETA_INDEX = (0, 3)
 THETA_NAMES = ("theta_11", "theta_22")
-STEP_LABELS = {"scalar": "scalar step [24]", "coordinate": "coordinate step"}
+STEP_LABELS = {"scalar": "scalar step (Pirotta et al. 2013)", "coordinate": "coordinate step"}
 STEP_COLORS = {"scalar": "#1f77b4", "coordinate": "#d62728"}
 FIXED_RUNS = (("N=1000", 1000, "#444444"), ("N=100", 100, "#2ca02c"))
 ADAPTIVE_COLOR = "#9467bd"
@@ -134,7 +134,7 @@ def steps_result(p: Mapping[str, Any], traces: Mapping[str, Any], data: Mapping[
 
 
 def lqg2d_steps_explorer() -> Ch5LiveExplorer:
-    """Figures 5.5-5.6 live: the scalar step of [24] against the coordinate step on the 2-D LQG.
+    """Figures 5.5-5.6 live: the scalar step of Pirotta et al. (2013) against the coordinate step on the 2-D LQG.
 
     Returns
     -------
@@ -171,8 +171,8 @@ def lqg2d_steps_explorer() -> Ch5LiveExplorer:
                 Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
                 Slider("seed", "seed", 0, 99, 1, 0)]
     plots = [Plot("theta", "updates", "gain theta_11, theta_22"), Plot("J", "updates", "expected performance J")]
-    ex = Ch5LiveExplorer("Figures 5.5-5.6 live: the scalar step of [24] against the coordinate step on the "
-                         "2-D LQG, computed in your browser", controls, plots, "", compute_py, data)
+    ex = Ch5LiveExplorer("Figures 5.5-5.6 live: the scalar step against the coordinate step on the 2-D LQG, "
+                         "computed in your browser", controls, plots, "", compute_py, data)
     ex.page_script, ex.page_object = "lqg2d_page.js", "safepgLqg2dSteps"
     ex.kernel_title = "Figures 5.5-5.6: scalar against coordinate step on the 2-D LQG, rerun by safepg here"
     return ex

@@ -52,12 +52,13 @@ from safepg.thesis.scorecard.export import (
     TABLES,
     counts,
     counts_text,
+    headline_numbers,
     read_csv,
     read_scorecard_json,
     write_scorecard,
 )
 from safepg.thesis.scorecard.links import BOOK, book_link
-from safepg.thesis.scorecard.page import group_html, summary_html
+from safepg.thesis.scorecard.page import group_html, row_anchor, summary_html
 from safepg.thesis.scorecard.rows import (
     AUTHORS_VARIANTS,
     NEEDED,
@@ -94,10 +95,11 @@ from safepg.thesis.scorecard.rules import (
 )
 
 __all__ = [
-    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "CURVE_SHARE", "FROZEN_THETA",
-    "GROUPS", "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS",
-    "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
+    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "CURVE_SHARE",
+    "FROZEN_THETA", "GROUPS", "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS",
+    "RATIO_POINTS", "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
     "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "counts_text", "group_html", "half_unit",
-    "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv", "read_scorecard_json",
-    "scorecard", "summary_html", "within_points", "within_rounding", "write_scorecard",
+    "headline_numbers", "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv",
+    "read_scorecard_json", "row_anchor", "scorecard", "summary_html", "within_points", "within_rounding",
+    "write_scorecard",
 ]

@@ -37,7 +37,7 @@ _THEORY_LINKS: tuple[tuple[str, str, str], ...] = (
 #: back to its id).
 THEORY_LABELS = {
     "thm_4_2_3_c": "penalty constant c", "cor_4_2_4_alpha": "step size 1/(2c)",
-    "cor_4_2_4_improvement": "guaranteed improvement", "cor_4_2_5_scalar_step": "scalar step of [24]",
+    "cor_4_2_4_improvement": "guaranteed improvement", "cor_4_2_5_scalar_step": "scalar step of Pirotta et al. (2013)",
     "cor_4_2_5_inequality": "coordinate step never worse than scalar", "cor_4_2_8_alpha": "step size with error ε",
     "cor_4_2_8_improvement": "guaranteed improvement with error ε", "sec_4_2_2_selection": "choice of k",
     "cor_4_2_8_actual_update": "guarantee for the update actually made", "thm_4_3_2_N0": "N₀",
@@ -46,7 +46,8 @@ THEORY_LABELS = {
     "chebyshev_N_star_reinforce": "Chebyshev N*, REINFORCE", "chebyshev_N_star_gpomdp": "Chebyshev N*, G(PO)MDP",
     "hoeffding_d": "Hoeffding d_δ", "bernstein_d_f": "Bernstein d_δ and f_δ", "bernstein_S_N": "sample variance S_N",
     "bernstein_N0": "Bernstein N₀", "bernstein_factors": "factors of dΥ/dN", "bernstein_descartes": "unique maximum",
-    "scalar_step_3_3_2": "scalar step α* of [24]", "scalar_improvement_3_3_2": "improvement of [24]",
+    "scalar_step_3_3_2": "scalar step α* of Pirotta et al. (2013)",
+    "scalar_improvement_3_3_2": "improvement of Pirotta et al. (2013)",
     "bound_3_7": "bound (3.7)", "lemma_a_0_1_hessian": "Gaussian second derivative",
     "lemma_a_0_1_statement": "Lemma A.0.1", "lemma_a_0_2_statement": "Lemma A.0.2",
     "lemma_b_0_3": "softmax second derivative", "lemma_b_0_5": "softmax policy distance",

@@ -50,6 +50,29 @@ def counts_text(rows: Sequence[Row]) -> str:
     return f"{sum(n.values())} printed results: {', '.join(parts)}{also}"
 
 
+#: The short name of each status in :func:`headline_numbers`' keys (``n_<name>``).
+STATUS_KEYS = {"reproduced": "reproduced", AUTHORS_STATUS: "authors_settings", AUTHORS_ERROR_STATUS: "authors_error",
+               VACUOUS_STATUS: "no_information", "differs (explained)": "explained", "open": "open"}
+
+
+def headline_numbers(rows: Sequence[Row]) -> dict[str, float]:
+    """The numbers the book's front page quotes, from the rows: ``n_rows`` and the rows per status
+    (``n_`` and a name of :data:`STATUS_KEYS`); the cart-pole's rows (``n_cartpole``) and those among
+    them reproduced only with the authors' settings (``n_cartpole_authors_settings``); and the 2-D
+    :math:`J(\theta^*)`: printed (``j_star_printed``), the expectation (``j_star_expected``) and
+    the ratio of the authors' code's value to the expectation (``j_star_ratio``)."""
+    n = counts(rows).get("all", dict.fromkeys(STATUSES, 0))
+    out: dict[str, float] = {"n_rows": sum(n.values()), **{f"n_{STATUS_KEYS[s]}": n[s] for s in STATUSES}}
+    cartpole = [r for r in rows if r.group == "Section 5.3"]
+    out["n_cartpole"] = len(cartpole)
+    out["n_cartpole_authors_settings"] = sum(r.status == AUTHORS_STATUS for r in cartpole)
+    j_star = next(r for r in rows if r.id == "section-5.2/J-star")
+    out["j_star_printed"] = j_star.thesis_value
+    out["j_star_expected"] = j_star.ours_value
+    out["j_star_ratio"] = j_star.authors_value / j_star.ours_value
+    return out
+
+
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
 CSV_COLUMNS = ("id", "group", "quantity", "where", "kind", "thesis", "ours", "difference", "status", "judged_on",
                "rule", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",

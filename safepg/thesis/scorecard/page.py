@@ -10,6 +10,7 @@ from functools import cache
 from importlib import resources
 
 from safepg.thesis.authors import REPOSITORY
+from safepg.thesis.citations import escape_and_link
 from safepg.thesis.scorecard.export import counts
 from safepg.thesis.scorecard.links import heading_id
 from safepg.thesis.scorecard.rules import AUTHORS_ERROR_STATUS, AUTHORS_STATUS, STATUSES, VACUOUS_STATUS, Row
@@ -78,8 +79,10 @@ def _cell(text: str, tex: str) -> str:
         # A formula cannot wrap: one longer than the cell scrolls inside its own box.
         return (f'<td class="sc-expr"><div class="sc-math"><span class="math notranslate nohighlight">'
                 f"\\({html.escape(tex)}\\)</span></div></td>")
-    # Numbers stay on one line; a long statement in words wraps.
-    return f'<td class="{"sc-num" if len(text) <= 32 else "sc-words"}">{_split(text)}</td>'
+    # Numbers stay on one line, their interval below; a long statement in words wraps, whole.
+    if len(text) <= 32:
+        return f'<td class="sc-num">{_split(text)}</td>'
+    return f'<td class="sc-words">{escape_and_link(text)}</td>'
 
 
 def _source_link(source: str) -> str:
@@ -113,6 +116,13 @@ def _authors_cells(r: Row) -> str:
     return f'{ours}<td class="sc-num sc-output">{html.escape(r.authors_output)}{slip}{src}</td>'
 
 
+def row_anchor(row_id: str) -> str:
+    """The id of a row's ``<tr>`` on the scorecard page: ``sc-`` and the row's id with every run of
+    characters other than letters, digits and dots made one hyphen (``section-5.2/J-star`` ->
+    ``sc-section-5.2-J-star``), so that other pages can link to the row."""
+    return "sc-" + re.sub(r"[^A-Za-z0-9.]+", "-", row_id).strip("-")
+
+
 def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
     """The rows of one group as an HTML table that scrolls inside its own box.
 
@@ -138,18 +148,19 @@ def group_html(rows: Sequence[Row], group: str, css: bool = False) -> str:
         if r.no_information:  # flagged where it stands, whatever the status
             ours = ours.replace("</td>", '<span class="sc-slip sc-noinfo">no information</span></td>', 1)
         body.append(
-            f'<tr class="sc-row" data-id="{html.escape(r.id)}" data-status="{html.escape(r.status)}" '
+            f'<tr class="sc-row" id="{row_anchor(r.id)}" data-id="{html.escape(r.id)}" '
+            f'data-status="{html.escape(r.status)}" '
             f'data-kind="{html.escape(r.kind)}" data-judged-on="{html.escape(r.judged_on)}" '
             f'data-thesis="{html.escape(r.thesis)}" data-ours="{html.escape(r.ours)}" '
             f'data-authors="{html.escape(r.authors)}">'
-            f'<td class="sc-result">{html.escape(r.quantity)}'
-            f'<span class="sc-detail">{html.escape(r.where)} · {html.escape(r.kind)}</span></td>'
+            f'<td class="sc-result">{escape_and_link(r.quantity)}'
+            f'<span class="sc-detail">{escape_and_link(r.where)} · {html.escape(r.kind)}</span></td>'
             f"<td>{_status_html(r.status)}{_judged_html(r)}</td>{_cell(r.thesis, r.thesis_tex)}{ours}"
             f'<td class="sc-num">{html.escape(r.difference)}</td>{_authors_cells(r) if wide else ""}'
             f'<td><a class="sc-link" href="{html.escape(r.link)}">{html.escape(_link_label(r.link))}</a></td></tr>')
         if r.explanation:
             body.append(f'<tr class="sc-note" data-for="{html.escape(r.id)}"><td colspan="{len(cols)}">'
-                        f'<div class="sc-pin">{html.escape(r.explanation)}</div></td></tr>')
+                        f'<div class="sc-pin">{escape_and_link(r.explanation)}</div></td></tr>')
     table = (f'<table class="sc-table sc-rows"><caption><div class="sc-pin">{html.escape(group)}: {line}</div>'
              f"</caption><thead>{head}</thead>"
              f"<tbody>{''.join(body)}</tbody></table>")

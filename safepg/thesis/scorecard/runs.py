@@ -288,7 +288,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                           recs: Mapping[str, Sequence[LearningRecord]]) -> None:
     for c, r in zip(exp.configs, rep["configs"]):
         th = r["thesis"] or {}
-        label = {"scalar": "scalar step of [24]", "coordinate": "coordinate step Λ*"}.get(c.name, c.name)
+        label = {"scalar": "scalar step of Pirotta et al. (2013)", "coordinate": "coordinate step Λ*"}[c.name]
         if "improvement_ratio" in th:
             mean, ci = _mean_ci(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")

@@ -19,7 +19,7 @@ const safepgLqg2dSteps = {
   },
   result(p, st, data) {
     const plots = {theta: {series: []}, J: {series: []}}, values = {}, lines = [];
-    const labels = {scalar: "scalar step [24]", coordinate: "coordinate step"};
+    const labels = {scalar: "scalar step (Pirotta et al. 2013)", coordinate: "coordinate step"};
     for (const step of ["scalar", "coordinate"]) {
       const r = st.runs[step];
       if (!r) { values[step] = null; continue; }
