@@ -28,7 +28,10 @@ class OfflinePage:
             route.abort()
 
     def typeset(self) -> None:
-        """Wait until MathJax has typeset the page."""
+        """Wait until MathJax has typeset the page (at once when the page loads no MathJax: Sphinx adds
+        it only to pages with maths, such as every page but the References)."""
+        if not self.page.evaluate("() => [...document.scripts].some(s => /mathjax/i.test(s.src))"):
+            return
         self.page.wait_for_function("() => window.MathJax && MathJax.startup && MathJax.startup.promise",
                                     timeout=20_000)
         self.page.evaluate("() => MathJax.startup.promise")

@@ -5,7 +5,8 @@ captions, the library's docstrings on the API page) names a work as one of
 :data:`safepg.thesis.citations.MENTIONS` ("Pirotta et al. (2013)"). After each page is resolved,
 every such mention outside code, maths, headings and existing links becomes a link to the entry's
 anchor (``bibtex_cite_id = "cite-{key}"``) on ``book/references``. A mention of a work that
-``references.bib`` does not hold is a build warning (an error under ``-W``).
+``references.bib`` does not hold is a build warning (an error under ``-W``). The References
+page's entries are list items for assistive technology.
 """
 
 from __future__ import annotations
@@ -63,7 +64,16 @@ def _link(app: Any, doctree: nodes.document, docname: str) -> None:
         text.parent.replace(text, [p for p in parts if not (isinstance(p, nodes.Text) and not str(p))])
 
 
+def _list_items(app: Any, pagename: str, templatename: str, context: dict, doctree: Any) -> None:
+    # docutils writes the bibliography as role="list" holding role="doc-biblioentry" entries; a
+    # list's children must be list items (axe: aria-required-children), and DPUB-ARIA has deprecated
+    # doc-biblioentry.
+    if pagename == REFERENCES_DOC and "body" in context:
+        context["body"] = context["body"].replace('role="doc-biblioentry"', 'role="listitem"')
+
+
 def setup(app: Any) -> dict[str, Any]:
     app.connect("env-check-consistency", _check_keys)
     app.connect("doctree-resolved", _link)
+    app.connect("html-page-context", _list_items)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
