@@ -398,7 +398,7 @@ def test_every_row_links_to_a_section_of_the_book(rows):
         if r.status == sc.AUTHORS_STATUS and not anchor:
             continue  # the chapter's section on the authors' settings, while it has no heading of that name
         assert anchor, f"{r.id} links to {page} without an anchor"
-        headings = [sc_links.heading_id(text) for _, text in sc_links._headings(page)]
+        headings = [sc_links.heading_id(text) for _, text in sc_links.headings(page)]
         assert anchor in headings, (r.id, r.link)
 
 

@@ -39,6 +39,7 @@ Modules (their public names used outside the package are available here):
 - :mod:`~safepg.thesis.scorecard.runs`: the rows of the Chapter 5 runs;
 - :mod:`~safepg.thesis.scorecard.outputs`: the authors' raw outputs beside the rows;
 - :mod:`~safepg.thesis.scorecard.rows`: :func:`scorecard`, every row;
+- :mod:`~safepg.thesis.scorecard.stored`: the rows built once per state of their inputs, and stored;
 - :mod:`~safepg.thesis.scorecard.export`: :func:`counts`, the CSV and JSON files;
 - :mod:`~safepg.thesis.scorecard.page`: the scorecard page's HTML.
 """

@@ -19,7 +19,7 @@ def heading_id(text: str) -> str:
 
 
 @cache
-def _headings(page: str, book: Path = BOOK) -> tuple[tuple[int, str], ...]:
+def headings(page: str, book: Path = BOOK) -> tuple[tuple[int, str], ...]:
     """(level, text) of the Markdown headings of ``book/page.ipynb``, in order."""
     path = book / f"{page}.ipynb"
     if not path.exists():
@@ -48,7 +48,7 @@ def book_link(page: str, heading: str | None = None, book: Path = BOOK) -> str:
     the chapter. Without a match (or without ``heading``) the link is the page itself.
     """
     if heading:
-        matches = [(level, text) for level, text in _headings(page, book) if heading.lower() in text.lower()]
+        matches = [(level, text) for level, text in headings(page, book) if heading.lower() in text.lower()]
         if matches:
             sections = [m for m in matches if m[0] > 1]
             return f"{page}.html#{heading_id((sections or matches)[0][1])}"

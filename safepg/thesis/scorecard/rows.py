@@ -6,6 +6,7 @@ from collections.abc import Collection, Mapping
 from pathlib import Path
 
 from safepg.learning import LearningRecord
+from safepg.store import results_dir
 from safepg.thesis.experiment_store import load_experiment, run_experiment
 from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment
 from safepg.thesis.report import report
@@ -15,6 +16,7 @@ from safepg.thesis.scorecard.curves import curve_rows
 from safepg.thesis.scorecard.links import BOOK
 from safepg.thesis.scorecard.rules import GROUPS, Row
 from safepg.thesis.scorecard.runs import run_rows
+from safepg.thesis.scorecard.stored import stored_rows
 
 #: The experiments the scorecard reads; ``table-5.1-printed-theta0`` is Table 5.1 from the
 #: printed theta_0, ``table-5.1`` our reconstruction of it (quoted beside).
@@ -42,7 +44,8 @@ RUN_PAGES = ("lqg1d", "lqg2d", "cartpole")
 
 
 def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mapping[str, Experiment] | None = None,
-              jobs: int = -1, book: Path | None = None, pages: Collection[str] | None = None) -> list[Row]:
+              jobs: int = -1, book: Path | None = None, pages: Collection[str] | None = None,
+              store: bool = True) -> list[Row]:
     """Every printed result of the thesis with ours, a status and a link.
 
     Parameters
@@ -66,6 +69,10 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     pages : collection of str, optional
         Only the rows linking to these pages (``"errata"``, ...). Without any page of
         :data:`RUN_PAGES` no run is read: a theory chapter's counts cost no record loading.
+    store : bool
+        With the default experiments and book, read the rows stored for the present state of
+        their inputs, or build and store them (:mod:`~safepg.thesis.scorecard.stored`): the
+        chapters of one build share one scorecard.
 
     Returns
     -------
@@ -76,6 +83,28 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
         b = Builder(book=book or BOOK)
         closed_form_rows(b)
         return _on_pages(b.rows, pages)
+    if store and experiments is None and book is None:
+        base = results_dir() if root is None else Path(root)
+        if run:
+            for e in _default_experiments().values():
+                run_experiment(e, root=base, jobs=jobs, progress=False)
+        rows = stored_rows(base, BOOK, lambda: _build(base, False, None, jobs, BOOK))
+    else:
+        rows = _build(root, run, experiments, jobs, book or BOOK)
+    return rows if pages is None else _on_pages(rows, pages)
+
+
+def _default_experiments() -> dict[str, Experiment]:
+    """The experiments whose missing runs ``run=True`` computes: :data:`NEEDED` and the range variant."""
+    exps = {n: get_experiment(n) for n in NEEDED}
+    variant = next((n for n in RANGE_VARIANTS if n in EXPERIMENTS), None)
+    if variant is not None:
+        exps[variant] = get_experiment(variant)
+    return exps
+
+
+def _build(root: Path | None, run: bool, experiments: Mapping[str, Experiment] | None, jobs: int,
+           book: Path) -> list[Row]:
     overrides = dict(experiments or {})
     known = NEEDED + RANGE_VARIANTS + AUTHORS_VARIANTS
     unknown = set(overrides) - set(known)
@@ -92,13 +121,12 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
             recs[n] = load_experiment(exps[n], root)
     reps = {n: report(e, recs[n]) for n, e in exps.items()}
 
-    b = Builder(book=book or BOOK)
+    b = Builder(book=book)
     closed_form_rows(b)
     run_rows(b, exps, reps, recs, variant)
     curve_rows(b, recs)
     order = {g: i for i, g in enumerate(GROUPS)}
-    rows = sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group
-    return rows if pages is None else _on_pages(rows, pages)
+    return sorted(b.rows, key=lambda r: order[r.group])  # stable: the thesis's order within a group
 
 
 def _on_pages(rows: list[Row], pages: Collection[str]) -> list[Row]:
