@@ -243,21 +243,38 @@ class View:
         self.el.locator(f".safepg-control-{name} select").select_option(label=label)
 
 
+#: The notebook's kernel has started (it answers, idle or busy: the widgets' manager asks it for its comms
+#: as soon as it connects), or JupyterLab says in a dialog that none could be started.
+KERNEL_STATE = """() => { if (document.querySelector('.jp-Dialog')) return 'dialog';
+                          const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
+                          const k = w && w.sessionContext && w.sessionContext.session
+                                    && w.sessionContext.session.kernel;
+                          return k && (k.status === 'idle' || k.status === 'busy') ? k.status : null; }"""
+
+
+def kernel_state(page: Any) -> str | None:
+    """Wait for the notebook's kernel to start; its status, ``'dialog'``, or None after KERNEL_MS."""
+    from playwright.sync_api import Error, TimeoutError
+
+    deadline = time.monotonic() + KERNEL_MS / 1000
+    while True:
+        try:
+            left_ms = max(1.0, (deadline - time.monotonic()) * 1000)
+            return page.wait_for_function(KERNEL_STATE, timeout=left_ms).json_value()
+        except TimeoutError:
+            return None
+        except Error:
+            # JupyterLab navigates once it has read ?token= from the URL, destroying the context the wait
+            # ran in: wait again in the new one.
+            if time.monotonic() > deadline:
+                return None
+
+
 def open_and_run(page: Any, lab: Lab) -> None:
     info = lab.info
     page.goto(f"{info['url']}lab/tree/explorers.ipynb?token={info['token']}")
-    # The notebook's kernel is idle, or JupyterLab says in a dialog that none could be started.
-    try:
-        page.wait_for_function(
-            """() => { const app = window.jupyterapp; const w = app && app.shell.currentWidget;
-                       const k = w && w.sessionContext && w.sessionContext.session
-                                 && w.sessionContext.session.kernel;
-                       return (k && k.status === 'idle') || document.querySelector('.jp-Dialog'); }""",
-            timeout=KERNEL_MS)
-    except Exception:
-        pass
-    if page.locator(".jp-Dialog").count() or not page.evaluate(
-            "() => window.jupyterapp.shell.currentWidget.sessionContext.session?.kernel?.status === 'idle'"):
+    state = kernel_state(page)
+    if state not in ("idle", "busy"):
         dialog = page.locator(".jp-Dialog").all_inner_texts()
         pytest.fail(f"the notebook has no running kernel (JupyterLab's dialog: {dialog}): is the kernel 'python3' "
                     f"of {VENV} registered? run `make setup`\n{lab.log_text()[-1500:]}")
