@@ -6,6 +6,8 @@
 PYTHON ?= python3
 VBIN := $(CURDIR)/.venv/bin
 VPY := $(VBIN)/python
+# Workers of `make test` (pytest-xdist): one per core.
+TEST_JOBS ?= auto
 
 # Every recipe runs the venv's tools, and so do their subprocesses (pytest's, jupyter-book's):
 # the venv's bin comes first on the PATH. Jupyter looks for kernels in the venv before
@@ -24,24 +26,29 @@ export JUPYTER_PREFER_ENV_PATH := 1
 setup:
 	@PYTHON_GIVEN=$(if $(filter command line environment override,$(origin PYTHON)),1) bash tools/setup_venv.sh "$(PYTHON)"
 
-# The tools of `make test` and `make dist` alone (requirements-dev.txt: build, check-wheel-contents),
-# on top of setup's venv; installed again when that file or setup's own install changes.
+# The tools of `make test`, `make dist` and `make wasm` alone (requirements-dev.txt: pytest, nbval, Playwright,
+# ruff, ziglang, build, ...), on top of setup's venv, by setup's uv; installed again when that file or
+# setup's own install changes.
 setup-dev: setup
 	@h=$$(cat requirements-dev.txt .venv/.safepg-setup | sha256sum | cut -d' ' -f1); \
 	if [ "$$(cat .venv/.safepg-dev 2>/dev/null)" != "$$h" ]; then \
-	  $(VPY) -m pip install --quiet --disable-pip-version-check -r requirements-dev.txt && echo "$$h" > .venv/.safepg-dev \
+	  UV_PYTHON_DOWNLOADS=never $(VBIN)/uv pip install --quiet --python $(VPY) -r requirements-dev.txt \
+	  && echo "$$h" > .venv/.safepg-dev \
 	  && echo "setup-dev: installed requirements-dev.txt into .venv"; fi
 
 # Debian's Chromium for the browser test (Playwright drives it; no browser download).
 browser-deps:
 	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null)
 
-# Lint (pyproject.toml's ruff rules) on the library, tests and benchmarks; notebooks are checked by nbval.
-lint: setup
-	$(VPY) -m ruff check safepg tests benchmarks
+# Lint (pyproject.toml's ruff rules) on the library, tests, benchmarks and the book's tools and extensions;
+# notebooks are checked by nbval.
+lint: setup-dev
+	$(VPY) -m ruff check safepg tests benchmarks book/tools book/_ext
 
-test: setup setup-dev browser-deps lint
-	$(VPY) -m pytest
+# The book first, as `make book` builds it (its computations use every core), then the tests on every
+# core (pytest-xdist; a test file's tests run in one worker, in order: nbval's cells need that).
+test: setup setup-dev browser-deps lint book
+	$(VPY) -m pytest -n $(TEST_JOBS) --dist loadfile
 
 test-lib: setup setup-dev
 	$(VPY) -m pytest tests -m "not browser"
@@ -55,10 +62,12 @@ book-assets:
 # First `safepg run-book` computes into results/ what the chapters compute (their experiments,
 # the Table 5.1 sweep, the safety measurements), on all cores as the notebooks do, with a
 # progress bar per experiment (plain lines, one per ~30 s, when stdout is not a terminal);
-# what is stored is one "stored" line each. The notebooks then only read results/.
+# what is stored is one "stored" line each. The notebooks then only read results/: execute_pages.py
+# executes them on every core into the execution cache, where jupyter-book finds them.
 book: setup book-assets
 	bash book/tools/cache_guard.sh
 	$(VPY) -m safepg run-book
+	$(VPY) book/tools/execute_pages.py
 	$(VBIN)/jupyter-book build . -W -n --keep-going
 
 # dist/: the sdist and the wheel (python -m build), the built book as safepg-book-<version>.tar.gz
@@ -70,7 +79,7 @@ bench: setup
 	$(VPY) benchmarks/bench_iteration.py
 
 # The page learner's WebAssembly kernel of the 2-D LQG, from its C source (tools/build_wasm.py).
-wasm: setup
+wasm: setup-dev
 	$(VPY) tools/build_wasm.py
 
 # JupyterLab on lab/, a git-ignored working copy of the book's chapters refreshed from book/

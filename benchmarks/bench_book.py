@@ -5,16 +5,20 @@
    into a preallocated buffer, one process per core) and safepg's own streams
    (:mod:`safepg.streams`, numba threads on every core). The fastest NumPy generator sets
    the floor: the time it needs to draw a computation's normals and uniforms.
-2. Copies the book (``_config.yml``, ``_toc.yml``, ``book/``) into a folder with no
-   ``results/`` and no execution cache and runs what ``make book`` runs (``python -m safepg
-   run-book``, then ``jupyter-book build``); each notebook's execution time comes from the build's jupyter-cache.
+2. Clones this repository's HEAD into an empty folder and runs there what a first ``make
+   book`` runs, phase by phase: ``make setup`` (the venv, by uv; ``--cold`` also empties uv's
+   cache), ``make book-assets``, ``python -m safepg run-book``, ``book/tools/execute_pages.py``
+   and ``jupyter-book build``, with the share of the cores each phase kept busy.
+   Nothing is carried over: no venv, no ``results/``, no execution cache and no numba cache
+   (the clone's own ``safepg/__pycache__``). Each notebook's execution time comes from the
+   build's jupyter-cache.
 3. Reads what the build computed from its results store (:mod:`safepg.thesis.budget`): per
    experiment and per chapter, the trajectories, steps and random numbers, the floor, the
    measured time and their ratio.
 
 Writes ``benchmarks/book_timings.json`` and prints the Markdown tables of the README.
 
-Usage: ``python benchmarks/bench_book.py [--keep DIR]``; ``--results DIR`` only re-reads the
+Usage: ``python benchmarks/bench_book.py [--keep DIR] [--cold]``; ``--results DIR`` only re-reads the
 store (and the execution cache) of an earlier build in DIR.
 """
 
@@ -24,6 +28,7 @@ import argparse
 import json
 import os
 import platform
+import resource
 import shutil
 import subprocess
 import sys
@@ -85,30 +90,65 @@ def chapter_times(work: Path) -> dict[str, float]:
     return {Path(r.uri).stem: round(r.data["execution_seconds"], 1) for r in cache.list_cache_records()}
 
 
-def build(work: Path) -> float:
-    """Build the book from empty in ``work``; its wall time."""
-    work.mkdir(parents=True, exist_ok=True)
-    for name in ("_config.yml", "_toc.yml"):
-        shutil.copy(ROOT / name, work / name)
-    shutil.copytree(ROOT / "book", work / "book", dirs_exist_ok=True,
-                    ignore=shutil.ignore_patterns("_build", ".ipynb_checkpoints"))
-    shutil.copytree(ROOT / "benchmarks", work / "benchmarks", dirs_exist_ok=True,
-                    ignore=shutil.ignore_patterns("*.py"))
-    assert not (work / "results").exists() and not (work / "_build").exists()
-    t0 = time.perf_counter()
-    # As `make book`: the chapters' experiments first, then the pages (the notebooks read the stored runs).
-    subprocess.run([sys.executable, "-m", "safepg", "run-book", "--book", str(work / "book"),
-                    "--root", str(work / "results")], cwd=work, check=True)
-    run_book = time.perf_counter() - t0
-    # From inside the copy: _config.yml's cache path is relative to the working directory.
-    # This interpreter's jupyter-book (.venv's, whose kernel is the venv's), not the PATH's first.
-    subprocess.run([str(Path(sys.executable).with_name("jupyter-book")), "build", ".", "-W", "-n", "--keep-going"],
-                   cwd=work, check=True, stdout=subprocess.DEVNULL)
-    wall = time.perf_counter() - t0
-    print(f"book from empty: {wall / 60:.1f} min, of which run-book {run_book / 60:.1f} min", flush=True)
+def _clean_env(work: Path, cold_cache: Path | None) -> dict[str, str]:
+    """The environment of a fresh shell in the clone ``work``, with the Makefile's venv variables."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("VIRTUAL_ENV", "NUMBA_CACHE_DIR", "JUPYTER_PATH", "JUPYTER_PREFER_ENV_PATH", "PYTHONPATH")}
+    here = {str(ROOT / ".venv" / "bin"), str(Path(sys.executable).parent)}
+    path = [d for d in env.get("PATH", "").split(os.pathsep) if d not in here]
+    env["PATH"] = os.pathsep.join([str(work / ".venv" / "bin"), *path])
+    if cold_cache is not None:
+        env["UV_CACHE_DIR"] = str(cold_cache)
+    return env
+
+
+def _children_cpu() -> float:
+    """User and system CPU seconds of this process's waited-for descendants so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def build(work: Path, cold: bool = False) -> dict[str, float]:
+    """A first ``make book`` in a fresh clone of HEAD at ``work``; the seconds of each phase."""
+    subprocess.run(["git", "clone", "--quiet", str(ROOT), str(work)], check=True)
+    cold_cache = work / ".uv-cache" if cold else None
+    env = _clean_env(work, cold_cache)
+    venv_bin = work / ".venv" / "bin"
+    # From inside the clone: _config.yml's cache path is relative to the working directory.
+    phases = {
+        "setup": ["make", "--no-print-directory", "setup"],
+        "book-assets": ["make", "--no-print-directory", "book-assets"],
+        "run-book": ["bash", "-c", f"bash book/tools/cache_guard.sh && {venv_bin}/python -m safepg run-book"],
+        "notebooks": [str(venv_bin / "python"), "book/tools/execute_pages.py"],
+        "pages": [str(venv_bin / "jupyter-book"), "build", ".", "-W", "-n", "--keep-going"],
+    }
+    seconds: dict[str, float] = {}
+    for phase, cmd in phases.items():
+        t0, cpu0 = time.perf_counter(), _children_cpu()
+        subprocess.run(cmd, cwd=work, env=env, check=True,
+                       stdout=subprocess.DEVNULL if phase == "pages" else None)
+        seconds[phase] = round(time.perf_counter() - t0, 1)
+        # Every process of the phase, waited for (the workers too): how busy the cores were.
+        busy = (_children_cpu() - cpu0) / (seconds[phase] * (os.cpu_count() or 1))
+        seconds[f"{phase}_cores_busy"] = round(busy, 2)
+        print(f"{phase}: {seconds[phase]:.1f} s, cores {busy:.0%} busy", flush=True)
+    wall = sum(v for k, v in seconds.items() if not k.endswith("_cores_busy"))
+    print(f"make book from empty: {wall / 60:.1f} min ({wall:.0f} s)", flush=True)
     if len(chapter_times(work)) < sum(1 for _ in (work / "book").glob("*.ipynb")):
         raise RuntimeError("some notebooks were not executed: the build did not start from empty")
-    return wall
+    if cold_cache is not None:
+        shutil.rmtree(cold_cache, ignore_errors=True)
+    seconds["venv_MB"] = round(sum(f.stat().st_size for f in (work / ".venv").rglob("*") if f.is_file()) / 1e6)
+    return seconds
+
+
+def phases_markdown(phases: dict[str, float]) -> str:
+    """The phases of the first ``make book`` as a Markdown table."""
+    names = [k for k in phases if k != "venv_MB" and not k.endswith("_cores_busy")]
+    total = sum(phases[k] for k in names)
+    rows = [f"| `{k}` | {phases[k]:.1f} | {phases[k + '_cores_busy']:.0%} |" for k in names]
+    return "\n".join(["| phase | seconds | cores busy |", "|---|---:|---:|", *rows,
+                      f"| **`make book` from empty** | **{total:.0f}** | |"])
 
 
 def machine() -> dict[str, object]:
@@ -130,7 +170,8 @@ def machine() -> dict[str, object]:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--keep", type=Path, help="build here (kept) instead of a temp folder")
+    ap.add_argument("--keep", type=Path, help="clone and build here (kept; must not exist) instead of a temp folder")
+    ap.add_argument("--cold", action="store_true", help="also start uv from an empty cache (downloads every package)")
     ap.add_argument("--results", type=Path,
                     help="no build: read the store and cache of an earlier build in this folder")
     args = ap.parse_args()
@@ -139,29 +180,35 @@ def main() -> None:
     fastest = max(numpy_rates, key=lambda k: numpy_rates[k]["normal"])
     normal_rate = numpy_rates[fastest]["normal"]
     uniform_rate = max(v["uniform"] for v in numpy_rates.values())
-    work = args.results or args.keep or Path(tempfile.mkdtemp(prefix="safepg-book-"))
+    work = args.results or args.keep or Path(tempfile.mkdtemp(prefix="safepg-book-")) / "clone"
     try:
-        wall = None if args.results else build(work)
+        phases = None if args.results else build(work, cold=args.cold)
+        wall = None if phases is None else sum(v for k, v in phases.items()
+                                               if k != "venv_MB" and not k.endswith("_cores_busy"))
         from safepg.thesis.budget import budget_rows, campaign, markdown
 
         chapters = chapter_times(work)
         budget = budget_rows(campaign(work / "results"), normal_rate, uniform_rate, chapters)
         out = {"date": time.strftime("%Y-%m-%d"), "cores": os.cpu_count(), "machine": machine(),
                "build_wall_s": None if wall is None
-               else round(wall, 1), "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
+               else round(wall, 1), "phases_s": phases, "uv_cache": "cold" if args.cold else "warm",
+               "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
                "generators_per_s_all_cores": {k: {kk: float(f"{vv:.4g}") for kk, vv in v.items()}
                                               for k, v in rates.items()},
                "floor_generator": fastest, "floor_normal_rate": float(f"{normal_rate:.4g}"),
                "floor_uniform_rate": float(f"{uniform_rate:.4g}"), **budget}
-        if wall is not None:
-            out["sphinx_and_overhead_s"] = round(wall - sum(chapters.values()), 1)
+        if phases is not None:
+            out["sphinx_s"] = phases["pages"]
         OUT.write_text(json.dumps(out, indent=1) + "\n")
-        print(json.dumps({k: out[k] for k in ("machine", "build_wall_s", "notebook_execution_s", "floor_generator",
+        print(json.dumps({k: out[k] for k in ("machine", "build_wall_s", "phases_s", "notebook_execution_s",
+                                              "floor_generator",
                                               "generators_per_s_all_cores")}, indent=1))
+        if phases is not None:
+            print(phases_markdown(phases) + "\n")
         print(markdown(budget))
     finally:
         if args.keep is None and args.results is None:
-            shutil.rmtree(work, ignore_errors=True)
+            shutil.rmtree(work.parent, ignore_errors=True)
 
 
 if __name__ == "__main__":

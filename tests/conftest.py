@@ -1,8 +1,9 @@
 """Shared fixtures: the built book and Debian's headless Chromium for the browser tests, and
 ``views`` for the tests of the explorers' kernel views.
 
-``book`` builds the book once per session (notebook execution goes through the
-Jupyter Book cache, so a rebuild with unchanged notebooks takes seconds);
+``book`` builds the book once per test run, as ``make book`` does (notebook execution goes
+through the Jupyter Book cache, so a rebuild with unchanged notebooks takes seconds); under
+pytest-xdist the first worker to ask builds it and the others wait for it;
 ``browser`` launches ``/usr/bin/chromium`` through Playwright, never a downloaded
 browser. Without Chromium (or Playwright) the browser tests are skipped, except under
 ``CI=true``, where they fail: CI must not pass by skipping them (``make browser-deps``
@@ -13,6 +14,7 @@ browser test shares this one.
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -58,15 +60,29 @@ def build_book() -> Path:
     subprocess.run(["bash", "book/tools/cache_guard.sh"], cwd=ROOT, check=True)
     # As `make book`: the chapters' experiments first (progress lines), then the pages from the stored runs.
     subprocess.run([sys.executable, "-m", "safepg", "run-book"], cwd=ROOT, check=True)
+    subprocess.run([sys.executable, "book/tools/execute_pages.py"], cwd=ROOT, check=True)
     subprocess.run([JUPYTER_BOOK, "build", ".", "-W", "-n", "--keep-going"], cwd=ROOT, check=True,
                    stdout=subprocess.DEVNULL)
     return HTML
 
 
 @pytest.fixture(scope="session")
-def book() -> Path:
-    """The book, built once per test session; ``_build/html``."""
-    return build_book()
+def book(request, tmp_path_factory) -> Path:
+    """The book, built once per test run; ``_build/html``.
+
+    Each pytest-xdist worker is a session of its own: they share a folder (the parent of their
+    temporary folders), where a lock lets one build while the others wait, and a file says it is built.
+    """
+    shared = tmp_path_factory.getbasetemp()
+    if hasattr(request.config, "workerinput"):
+        shared = shared.parent
+    with (shared / "book.lock").open("w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        built = shared / "book-built"
+        if not built.exists():
+            build_book()
+            built.touch()
+    return HTML
 
 
 @pytest.fixture(scope="session")
@@ -77,7 +93,7 @@ def browser() -> Iterator[Any]:
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
-        skip_or_fail("playwright (python) is not installed: run `make setup`")
+        skip_or_fail("playwright (python) is not installed: run `make setup-dev`")
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield browser

@@ -91,11 +91,31 @@ def test_renumbering_overrides_sphinx_counts():
         "book/lqg2d": {"figure": {"fig-5-5": (1,), "fig-5-6": (2,)}, "table": {"table-5-3": (1,)}},
         "book/cartpole": {"figure": {"fig-s5-1": (1,)}, "code-block": {"x": (1,)}},
     })
-    assert mod._renumber(None, env) == []
+    mod._renumber(env)
     assert env.toc_fignumbers["book/lqg2d"]["figure"] == {"fig-5-5": ("5", 5), "fig-5-6": ("5", 6)}
     assert env.toc_fignumbers["book/lqg2d"]["table"] == {"table-5-3": ("5", 3)}
     assert env.toc_fignumbers["book/cartpole"]["figure"] == {"fig-s5-1": ("S5", 1)}
     assert env.toc_fignumbers["book/cartpole"]["code-block"] == {"x": (1,)}  # other kinds untouched
+
+
+def test_an_unchanged_book_rewrites_no_page_for_its_numbers():
+    """Sphinx rewrites the pages whose figure numbers changed since the last build: with the thesis's
+    numbers, only a page whose labels changed counts, not every page with a figure at every build."""
+    mod = _thesis_numbers()
+    labels = {"book/lqg2d": ["fig-5-5", "fig-5-6"], "book/cartpole": ["fig-s5-1"]}
+
+    def sphinx_running_numbers(self, env):  # what Sphinx's collector does: 1, 2, ... per page
+        env.toc_fignumbers = {doc: {"figure": {lab: (i + 1,) for i, lab in enumerate(labs)}}
+                              for doc, labs in labels.items()}
+        return sorted(env.toc_fignumbers)
+
+    assign = mod._thesis_figure_numbers(sphinx_running_numbers)
+    env = SimpleNamespace(toc_fignumbers={})
+    assert sorted(assign(None, env)) == ["book/cartpole", "book/lqg2d"]  # the first build
+    assert assign(None, env) == []  # nothing changed
+    labels["book/cartpole"] = ["fig-s5-2"]
+    assert assign(None, env) == ["book/cartpole"]
+    assert env.toc_fignumbers["book/cartpole"]["figure"] == {"fig-s5-2": ("S5", 2)}
 
 
 def test_figure_4_1_tick_labels_do_not_overlap():

@@ -141,7 +141,7 @@ def test_the_shortcut_past_math_exp_answers_as_math_exp() -> None:
 
 
 def test_the_committed_binary_is_what_the_source_compiles_to(tmp_path: Path) -> None:
-    pytest.importorskip("ziglang", reason="the kernel's compiler (requirements.txt) is not installed")
+    pytest.importorskip("ziglang", reason="the kernel's compiler (requirements-dev.txt) is not installed")
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("build_wasm", ROOT / "tools" / "build_wasm.py")

@@ -1,7 +1,7 @@
 """Compile the page learner's WebAssembly kernel: ``make wasm``.
 
 ``safepg/thesis/explorers/wasm/lqg2d_kernel.c`` -> ``safepg/thesis/explorers/static/lqg2d_kernel.wasm``
-with the clang of the pinned ``ziglang`` package (requirements.txt), so that every machine
+with the clang of the pinned ``ziglang`` package (requirements-dev.txt), so that every machine
 compiles the same bytes: tests/test_wasm_kernel.py compiles it again and compares.
 
 Usage: python tools/build_wasm.py [--out PATH]

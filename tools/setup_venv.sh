@@ -63,15 +63,23 @@ if [ ! -x "$vpy" ]; then
   "$base" -m venv "$venv"
 fi
 
+# The installer: uv, pinned, from PyPI into the venv by the venv's pip (seconds where pip takes
+# over a minute: it resolves once and links from its cache). It only ever installs into this
+# venv's interpreter, never one of its own (UV_PYTHON_DOWNLOADS=never, --python).
+UV_PIN=uv==0.13.9
+export UV_PYTHON_DOWNLOADS=never
+uv_install() { "$venv/bin/uv" pip install --quiet --python "$vpy" "$@"; }
+
 # What the install depends on: the pins, the package's metadata (its version is read from
-# safepg/__init__.py) and the venv's interpreter.
-inputs=$( { cat requirements.txt pyproject.toml; grep '^__version__' safepg/__init__.py 2>/dev/null || true; base_of "$vpy"; } \
-  | sha256sum | cut -d' ' -f1)
+# safepg/__init__.py), the installer and the venv's interpreter.
+inputs=$( { cat requirements.txt pyproject.toml; grep '^__version__' safepg/__init__.py 2>/dev/null || true; \
+            echo "$UV_PIN"; base_of "$vpy"; } | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$inputs" ]; then
   rm -f "$stamp"  # an interrupted install is redone next time
   start=$SECONDS
-  "$vpy" -m pip install --quiet --disable-pip-version-check -r requirements.txt
-  "$vpy" -m pip install --quiet --disable-pip-version-check --no-deps -e .
+  "$vpy" -m pip install --quiet --disable-pip-version-check "$UV_PIN"
+  uv_install -r requirements.txt
+  uv_install --no-deps -e .
   # The notebooks' kernel "python3", inside the venv (never --user: that one would be every
   # clone's). Jupyter run from the venv, or with the JUPYTER_PATH the Makefile sets, finds it
   # before any kernel of that name in ~/.local/share/jupyter.

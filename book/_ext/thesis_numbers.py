@@ -16,8 +16,10 @@ on the pages is chosen, none is Sphinx's running count.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Any
 
+from sphinx.environment.collectors.toctree import TocTreeCollector
 from sphinx.util import logging
 
 logger = logging.getLogger(__name__)
@@ -36,7 +38,7 @@ def thesis_number(label: str) -> tuple[str, tuple[str, int]] | None:
     return KINDS[m[1]], (m[2].upper(), int(m[3]))
 
 
-def _renumber(app: Any, env: Any) -> list[str]:
+def _renumber(env: Any) -> None:
     seen: dict[tuple[str, tuple[str, int]], str] = {}
     for docname, kinds in env.toc_fignumbers.items():
         for figtype, numbers in kinds.items():
@@ -57,10 +59,27 @@ def _renumber(app: Any, env: Any) -> list[str]:
                                    location=docname)
                 seen[wanted] = docname
                 numbers[node_id] = wanted[1]
-    return []
+
+
+def _thesis_figure_numbers(assign: Callable[[Any, Any], list[str]]) -> Callable[[Any, Any], list[str]]:
+    """Sphinx's figure numbering, then the thesis's numbers, and the pages whose numbers changed.
+
+    Sphinx rewrites every page whose numbers differ from the last build's. Its own comparison
+    sets its running numbers against the thesis numbers stored last time, so they always
+    differ and every page with a figure was rewritten on every build: compare the thesis
+    numbers with the thesis numbers instead.
+    """
+    def assign_figure_numbers(self: Any, env: Any) -> list[str]:
+        old = env.toc_fignumbers
+        assign(self, env)
+        _renumber(env)
+        return [doc for doc, numbers in env.toc_fignumbers.items() if numbers != old.get(doc)]
+
+    assign_figure_numbers.thesis_numbers = True  # type: ignore[attr-defined]
+    return assign_figure_numbers
 
 
 def setup(app: Any) -> dict[str, Any]:
-    # After Sphinx's own TocTreeCollector (priority 500) has assigned its running numbers.
-    app.connect("env-get-updated", _renumber, priority=900)
+    if not getattr(TocTreeCollector.assign_figure_numbers, "thesis_numbers", False):
+        TocTreeCollector.assign_figure_numbers = _thesis_figure_numbers(TocTreeCollector.assign_figure_numbers)
     return {"parallel_read_safe": True, "parallel_write_safe": True}

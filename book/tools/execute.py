@@ -18,7 +18,9 @@ def main(paths: list[str]) -> None:
     for p in map(Path, paths):
         nb = nbformat.read(p, as_version=4)
         t = time.perf_counter()
-        NotebookClient(nb, timeout=3600, kernel_name="python3", resources={"metadata": {"path": str(p.parent)}}).execute()
+        folder = {"metadata": {"path": str(p.parent)}}
+        client = NotebookClient(nb, timeout=3600, kernel_name="python3", resources=folder)
+        client.execute()
         nbformat.write(nb, p)
         print(f"{p}: {time.perf_counter() - t:.1f} s", flush=True)
 
