@@ -36,6 +36,20 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-backg
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """Under pytest-xdist, numba's parallel kernels start on one thread in each worker.
+
+    The workers already share the cores; with numba's threads on every core too, two workers'
+    parallel regions wait on each other's descheduled threads (a module's setup took 56 s instead
+    of 9). A test that asks for more threads gets them (``numba.set_num_threads``), and a seeded
+    run gives the same numbers on any number of threads (``tests/test_streams.py``).
+    """
+    if hasattr(config, "workerinput"):
+        import numba
+
+        numba.set_num_threads(1)
+
+
 def in_ci() -> bool:
     """True when the environment says this is a CI run (``CI=true``)."""
     return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")

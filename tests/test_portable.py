@@ -296,7 +296,8 @@ def test_source_scan_can_fail(tmp_path: Path) -> None:
 def _probe(env: dict[str, str], cache: Path) -> subprocess.Popen:
     full = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CPU_NAME", "GLIBC_TUNABLES",
                                                             "NPY_DISABLE_CPU_FEATURES")}
-    full.update(env, NUMBA_CACHE_DIR=str(cache))  # a fresh cache: every kernel compiled for this CPU setting
+    # A fresh cache: every kernel compiled for this CPU setting. One thread each: three probes share the cores.
+    full.update(env, NUMBA_CACHE_DIR=str(cache), NUMBA_NUM_THREADS="1")
     return subprocess.Popen([sys.executable, str(ROOT / "tests" / "portable_probe.py")], env=full, cwd=ROOT,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
