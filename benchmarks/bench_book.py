@@ -108,8 +108,9 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def build(work: Path, cold: bool = False) -> dict[str, float]:
-    """A first ``make book`` in a fresh clone of HEAD at ``work``; the seconds of each phase."""
+def build(work: Path, cold: bool = False) -> dict[str, dict[str, float]]:
+    """A first ``make book`` in a fresh clone of HEAD at ``work``; each phase's ``seconds`` and
+    ``cores_busy`` (the CPU time of its processes over its wall time on every core)."""
     subprocess.run(["git", "clone", "--quiet", str(ROOT), str(work)], check=True)
     cold_cache = work / ".uv-cache" if cold else None
     env = _clean_env(work, cold_cache)
@@ -122,33 +123,40 @@ def build(work: Path, cold: bool = False) -> dict[str, float]:
         "notebooks": [str(venv_bin / "python"), "book/tools/execute_pages.py"],
         "pages": [str(venv_bin / "jupyter-book"), "build", ".", "-W", "-n", "--keep-going"],
     }
-    seconds: dict[str, float] = {}
+    measured: dict[str, dict[str, float]] = {}
     for phase, cmd in phases.items():
         t0, cpu0 = time.perf_counter(), _children_cpu()
         subprocess.run(cmd, cwd=work, env=env, check=True,
                        stdout=subprocess.DEVNULL if phase == "pages" else None)
-        seconds[phase] = round(time.perf_counter() - t0, 1)
+        seconds = time.perf_counter() - t0
         # Every process of the phase, waited for (the workers too): how busy the cores were.
-        busy = (_children_cpu() - cpu0) / (seconds[phase] * (os.cpu_count() or 1))
-        seconds[f"{phase}_cores_busy"] = round(busy, 2)
-        print(f"{phase}: {seconds[phase]:.1f} s, cores {busy:.0%} busy", flush=True)
-    wall = sum(v for k, v in seconds.items() if not k.endswith("_cores_busy"))
+        busy = (_children_cpu() - cpu0) / (seconds * (os.cpu_count() or 1))
+        measured[phase] = {"seconds": round(seconds, 1), "cores_busy": round(busy, 2)}
+        print(f"{phase}: {seconds:.1f} s, cores {busy:.0%} busy", flush=True)
+    wall = wall_seconds(measured)
     print(f"make book from empty: {wall / 60:.1f} min ({wall:.0f} s)", flush=True)
     if len(chapter_times(work)) < sum(1 for _ in (work / "book").glob("*.ipynb")):
         raise RuntimeError("some notebooks were not executed: the build did not start from empty")
     if cold_cache is not None:
         shutil.rmtree(cold_cache, ignore_errors=True)
-    seconds["venv_MB"] = round(sum(f.stat().st_size for f in (work / ".venv").rglob("*") if f.is_file()) / 1e6)
-    return seconds
+    return measured
 
 
-def phases_markdown(phases: dict[str, float]) -> str:
+def wall_seconds(phases: dict[str, dict[str, float]]) -> float:
+    """The whole build's wall time: its phases' seconds."""
+    return sum(p["seconds"] for p in phases.values())
+
+
+def venv_megabytes(work: Path) -> int:
+    """The size of the clone's venv, in MB."""
+    return round(sum(f.stat().st_size for f in (work / ".venv").rglob("*") if f.is_file()) / 1e6)
+
+
+def phases_markdown(phases: dict[str, dict[str, float]]) -> str:
     """The phases of the first ``make book`` as a Markdown table."""
-    names = [k for k in phases if k != "venv_MB" and not k.endswith("_cores_busy")]
-    total = sum(phases[k] for k in names)
-    rows = [f"| `{k}` | {phases[k]:.1f} | {phases[k + '_cores_busy']:.0%} |" for k in names]
+    rows = [f"| `{k}` | {p['seconds']:.1f} | {p['cores_busy']:.0%} |" for k, p in phases.items()]
     return "\n".join(["| phase | seconds | cores busy |", "|---|---:|---:|", *rows,
-                      f"| **`make book` from empty** | **{total:.0f}** | |"])
+                      f"| **`make book` from empty** | **{wall_seconds(phases):.0f}** | |"])
 
 
 def machine() -> dict[str, object]:
@@ -183,24 +191,21 @@ def main() -> None:
     work = args.results or args.keep or Path(tempfile.mkdtemp(prefix="safepg-book-")) / "clone"
     try:
         phases = None if args.results else build(work, cold=args.cold)
-        wall = None if phases is None else sum(v for k, v in phases.items()
-                                               if k != "venv_MB" and not k.endswith("_cores_busy"))
         from safepg.thesis.budget import budget_rows, campaign, markdown
 
         chapters = chapter_times(work)
         budget = budget_rows(campaign(work / "results"), normal_rate, uniform_rate, chapters)
         out = {"date": time.strftime("%Y-%m-%d"), "cores": os.cpu_count(), "machine": machine(),
-               "build_wall_s": None if wall is None
-               else round(wall, 1), "phases_s": phases, "uv_cache": "cold" if args.cold else "warm",
+               "build_wall_s": None if phases is None else round(wall_seconds(phases), 1), "phases": phases,
+               "venv_MB": None if phases is None else venv_megabytes(work),
+               "uv_cache": "cold" if args.cold else "warm",
                "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
                "generators_per_s_all_cores": {k: {kk: float(f"{vv:.4g}") for kk, vv in v.items()}
                                               for k, v in rates.items()},
                "floor_generator": fastest, "floor_normal_rate": float(f"{normal_rate:.4g}"),
                "floor_uniform_rate": float(f"{uniform_rate:.4g}"), **budget}
-        if phases is not None:
-            out["sphinx_s"] = phases["pages"]
         OUT.write_text(json.dumps(out, indent=1) + "\n")
-        print(json.dumps({k: out[k] for k in ("machine", "build_wall_s", "phases_s", "notebook_execution_s",
+        print(json.dumps({k: out[k] for k in ("machine", "build_wall_s", "phases", "notebook_execution_s",
                                               "floor_generator",
                                               "generators_per_s_all_cores")}, indent=1))
         if phases is not None:

@@ -265,8 +265,10 @@ def kernel_state(page: Any) -> str | None:
             return None
         except Error:
             # JupyterLab navigates once it has read ?token= from the URL, destroying the context the wait
-            # ran in: wait again in the new one.
-            if time.monotonic() > deadline:
+            # ran in: wait again in the new document once it has loaded.
+            try:
+                page.wait_for_load_state("domcontentloaded", timeout=max(1.0, (deadline - time.monotonic()) * 1000))
+            except TimeoutError:
                 return None
 
 

@@ -31,16 +31,11 @@ import yaml
 from jupyter_cache import get_cache
 from jupyter_cache.base import CacheBundleIn
 
+from safepg.thesis.prefetch import chapters
+
 ROOT = Path(__file__).resolve().parents[2]
 #: The previous build's execution seconds per notebook (benchmarks/bench_book.py): longest first.
 TIMINGS = ROOT / "benchmarks" / "book_timings.json"
-
-
-def notebooks() -> list[Path]:
-    """The table of contents' notebooks."""
-    toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
-    files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
-    return [ROOT / f"{f}.ipynb" for f in files if (ROOT / f"{f}.ipynb").is_file()]
 
 
 def build_scorecard() -> str:
@@ -66,7 +61,7 @@ def main() -> int:
     config = yaml.safe_load((ROOT / "_config.yml").read_text())["execute"]
     cache = get_cache(str(ROOT / config["cache"]))
     todo = []
-    for path in notebooks():
+    for path in chapters(ROOT / "book"):
         try:
             cache.match_cache_notebook(nbformat.read(path, as_version=4))
         except KeyError:
