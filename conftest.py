@@ -5,12 +5,22 @@ that kernel inside ``.venv`` (never in ``~/.local``), and the Makefile makes Jup
 there first. Refuse to start when the kernel is missing, or when it would run another
 interpreter than the one running the tests: the notebooks would then import another
 environment's (another clone's) ``safepg`` and test that instead of this one.
+
+Under pytest-xdist the workers already share the cores, so each worker's notebooks run on a
+copy of that kernel whose numba starts on one thread (``NUMBA_NUM_THREADS=1`` in the copy's
+``env``), as ``book/tools/execute_pages.py`` runs them for the book: beside the other worker,
+the cart-pole chapter's longest cell took 54 s with two threads and 28 s alone. The copy has
+its own name, so ``python3`` itself, which JupyterLab and the setup tests use, is untouched.
 """
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 
@@ -40,3 +50,23 @@ def pytest_configure(config: pytest.Config) -> None:
             f"nbval would run the notebooks with {kernel_python} (the kernel 'python3' of "
             f"{spec.resource_dir}), not with {sys.executable} that runs the tests, so with another "
             "safepg: run `make test`, or pytest from the activated .venv (`. .venv/bin/activate`)")
+    if hasattr(config, "workerinput") and not config.option.nbval_kernel_name:
+        config.option.nbval_kernel_name = _one_thread_kernel(config, spec.to_dict())
+
+
+ONE_THREAD_KERNEL = "safepg-one-thread"
+
+
+def _one_thread_kernel(config: pytest.Config, spec: dict) -> str:
+    """Register, for this process only, a copy of the kernel ``spec`` whose numba runs one thread."""
+    data = tempfile.mkdtemp(prefix="safepg-kernels-")
+    config.add_cleanup(lambda: shutil.rmtree(data, ignore_errors=True))
+    folder = os.path.join(data, "kernels", ONE_THREAD_KERNEL)
+    os.makedirs(folder)
+    spec = {**spec, "display_name": f"{spec['display_name']} (numba on one thread)",
+            "env": {**spec.get("env", {}), "NUMBA_NUM_THREADS": "1"}}
+    with open(os.path.join(folder, "kernel.json"), "w") as f:
+        json.dump(spec, f)
+    # Last on the path: the copy adds a kernel and shadows none.
+    os.environ["JUPYTER_PATH"] = os.pathsep.join(p for p in (os.environ.get("JUPYTER_PATH"), data) if p)
+    return ONE_THREAD_KERNEL

@@ -273,3 +273,27 @@ def test_without_ensurepip_elsewhere_says_what_to_install(tmp_path):
     assert proc.stderr == (f"setup: {base} cannot create a virtual environment (no ensurepip): install "
                            f"python{version}-venv (apt-get install python{version}-venv) or set PYTHON to another "
                            "Python >= 3.11\n")
+
+
+def test_nbval_kernel_beside_other_workers_runs_numba_on_one_thread(request: pytest.FixtureRequest) -> None:
+    """Under pytest-xdist, nbval's kernel is ``python3`` with numba on one thread (conftest.py)."""
+    if not hasattr(request.config, "workerinput"):
+        pytest.skip("only under pytest-xdist: alone, the notebooks keep every core")
+    from jupyter_client.kernelspec import KernelSpecManager
+    from jupyter_client.manager import start_new_kernel
+
+    name = request.config.option.nbval_kernel_name
+    assert name and name != "python3"
+    assert KernelSpecManager().get_kernel_spec(name).argv == KernelSpecManager().get_kernel_spec("python3").argv
+    km, kc = start_new_kernel(kernel_name=name, startup_timeout=120, cwd=str(ROOT / "book"))
+    out: list[str] = []
+    try:
+        kc.execute_interactive("import numba, sys; print(numba.config.NUMBA_NUM_THREADS, sys.executable)",
+                               timeout=120, output_hook=lambda msg: msg["msg_type"] == "stream"
+                               and out.append(msg["content"]["text"]))
+    finally:
+        kc.stop_channels()
+        km.shutdown_kernel(now=True)
+    threads, executable = "".join(out).split()
+    assert threads == "1"
+    assert Path(executable).resolve().parent == Path(sys.executable).resolve().parent
