@@ -68,7 +68,7 @@ def jobs_integer(text: str) -> int:
     return value
 
 
-def _learn_parser(sub: argparse._SubParsersAction) -> None:
+def _learn_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("learn", help="run one learning loop and print a JSON summary")
     p.add_argument("--env", choices=sorted(ENVS), default="lqg1d")
     p.add_argument("--estimator", choices=["reinforce", "gpomdp"], default="gpomdp")
@@ -91,7 +91,7 @@ def _learn_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def _run_learn(args: argparse.Namespace) -> dict:
+def _run_learn(args: argparse.Namespace) -> dict[str, Any]:
     env = ENVS[args.env]()
     theta0 = np.asarray(args.theta0, dtype=float)
     if theta0.size == 1:
@@ -120,7 +120,7 @@ class DamagedStoreError(LookupError):
     """``report`` found damaged run files (the CLI names each, says how to repair, exits with status 1)."""
 
 
-def _experiment_parsers(sub: argparse._SubParsersAction) -> None:
+def _experiment_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("list", help="name every experiment")
     p.set_defaults(func=_cmd_list)
     p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")

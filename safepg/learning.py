@@ -351,14 +351,13 @@ def vanilla_pg(
     policy = _initial_policy(hooks, theta0, sigma)
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
-    safe_step = step if isinstance(step, SafeStep) else None
 
     def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
-        if safe_step is None:
+        if isinstance(step, FixedStep):
             eps, safe, a = 0.0, True, step.alpha
         else:
-            e = safe_step.error
+            e = step.error
             # One common eps for all components: the largest per-component bound.
             eps = max(float(error_bound(e.bound, samples[:, i], e.delta, constants, gradient.estimator,
                                         e.range).eps(n)) for i in range(grad.size))
@@ -370,10 +369,10 @@ def vanilla_pg(
         d[k] = a * grad[k]
         return _Update(d, a, k, eps, safe, batch_size)
 
-    e = safe_step.error if safe_step is not None else ErrorModel()
+    e = step.error if isinstance(step, SafeStep) else ErrorModel()
     config = dict(
         algorithm="vanilla", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
-        sigma=sigma, batch_size=batch_size, alpha=None if safe_step is not None else step.alpha, step=step.kind,
+        sigma=sigma, batch_size=batch_size, alpha=step.alpha if isinstance(step, FixedStep) else None, step=step.kind,
         estimator=gradient.estimator, baseline=gradient.baseline, bound=e.bound, delta=e.delta,
         empirical_range=e.empirical_range, budget=budget, score_action=gradient.score_action, c=c,
         target_return=None if target is None else target.value,

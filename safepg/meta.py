@@ -190,7 +190,7 @@ def n_star_bernstein_root(g: float, bound: ErrorBound) -> float:
     d, f = bound.d, bound.f
     roots = np.roots([-(g**2), 3 * d * g, 2 * d * d + 6 * f * g, 5 * d * f, 3 * f * f])
     pos = [r.real for r in roots if abs(r.imag) < 1e-9 * max(1.0, abs(r)) and r.real > 0]
-    return max(pos) ** 2
+    return float(max(pos) ** 2)
 
 
 def optimal_batch_size(

@@ -114,7 +114,8 @@ class LearningRecord:
 
     @property
     def theta_final(self) -> np.ndarray:
-        return self.theta[-1]
+        last: np.ndarray = self.theta[-1]
+        return last
 
     def upsilon_bar(self) -> float:
         r"""Average performance :math:`\overline\Upsilon` (Tables 5.2-5.4): the measured
@@ -168,7 +169,8 @@ class LearningRecord:
 
     def save(self, path: str | Path) -> None:
         """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
-        arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
+        # Any: numpy types **kwargs as if one of them could be allow_pickle.
+        arrays: dict[str, Any] = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
         meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged,
                            "reached_target": self.reached_target})
         np.savez_compressed(path, meta=np.array(meta), **arrays)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import numpy as np
 
@@ -42,7 +42,8 @@ class Task(BoundedTask, Protocol):
 class ActionDimension(Protocol):
     """A task whose actions have ``action_dim`` components (the gain has that many rows)."""
 
-    action_dim: int
+    @property
+    def action_dim(self) -> int: ...
 
 
 class GradientBatch(Protocol):
@@ -152,7 +153,7 @@ def task_hooks(task: Task) -> Hooks:
             found[name] = getattr(task, name)
     action_dim = 1
     if ActionDimension in cls.__mro__:
-        action_dim = task.action_dim  # type: ignore[attr-defined]
+        action_dim = cast(ActionDimension, task).action_dim  # declared: the class inherits it
         if isinstance(action_dim, bool) or not isinstance(action_dim, int | np.integer) or action_dim < 1:
             raise TypeError(f"{cls.__name__}.action_dim must be an integer >= 1, got {action_dim!r}")
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))

@@ -8,6 +8,7 @@ runs to the end of its budget.
 
 from __future__ import annotations
 
+import inspect
 import pickle
 import time
 from typing import Any
@@ -71,7 +72,8 @@ def counter_task(**kw: Any) -> GymTask:
 def test_simulation_constants_are_required_at_construction(missing: str) -> None:
     args = {"horizon": 5, "gamma": 0.5}
     del args[missing]
-    with pytest.raises(ValueError, match=rf"^{missing} must be given"):
+    assert inspect.signature(GymTask).parameters[missing].default is inspect.Parameter.empty
+    with pytest.raises(TypeError, match=rf"required keyword-only argument: '{missing}'"):
         GymTask(CounterEnv, **args)
 
 

@@ -127,7 +127,7 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
 
     # ----------------------------------------------------------------- simulator
     @property
-    def action_dim(self) -> int:  # type: ignore[override]
+    def action_dim(self) -> int:
         """Actions have as many components as states (``dim``)."""
         return self.dim
 
@@ -196,7 +196,8 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
             # LAPACK's eigenvalues may differ across CPUs in the last bit; only the yes/no
             # answer is used, and it could flip only for a gain exactly on the boundary.
             radius = np.max(np.abs(np.linalg.eigvals(F)), axis=1)
-        return radius * np.sqrt(self.gamma) < 1
+        stable: np.ndarray = radius * np.sqrt(self.gamma) < 1
+        return stable
 
     def _lyapunov(self, F: np.ndarray, M: np.ndarray) -> np.ndarray:
         r"""P solving :math:`P = M + \gamma F^\top P F` for a batch (I, m, m) of F and M.
@@ -228,7 +229,8 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
         K = self._gain(theta)
         if not self.is_stable(K):
             raise ValueError("theta makes the closed loop unstable: J(theta) = -inf")
-        return self._value_matrices(K[None])[0]
+        P: np.ndarray = self._value_matrices(K[None])[0]
+        return P
 
     def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
         r"""Closed-form expected performance J(theta) (infinite horizon, no clipping).
@@ -353,13 +355,16 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
                  score_action == "clipped", estimator == "reinforce", bool(baseline))
         # One chunk, or one thread (a campaign's worker): the serial build, the same numbers.
         serial = n <= kernels.CHUNK or numba.get_num_threads() == 1
+        out: tuple[np.ndarray, np.ndarray]  # (samples, returns)
         if self.dim == 1:
             kernel = kernels.lqg1d_gradient_samples_serial if serial else kernels.lqg1d_gradient_samples
-            return kernel(float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
-                          float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
+            out = kernel(float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
+                         float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
+            return out
         # m = 2 (Section 5.2) has its own unrolled kernel; m >= 3 uses the generic loops.
         if self.dim == 2:
             kernel = kernels.lqg2d_gradient_samples_serial if serial else kernels.lqg2d_gradient_samples
         else:
             kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
-        return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        out = kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        return out

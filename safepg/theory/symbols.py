@@ -77,7 +77,8 @@ def latex(expr: sp.Basic | str, **kwargs: object) -> str:
     """
     if isinstance(expr, str):
         return expr
-    return sp.latex(expr, symbol_names=LATEX_NAMES, **kwargs)
+    text: str = sp.latex(expr, symbol_names=LATEX_NAMES, **kwargs)
+    return text
 
 
 def tidy(expr: sp.Expr) -> sp.Expr:
@@ -87,7 +88,7 @@ def tidy(expr: sp.Expr) -> sp.Expr:
 
 def is_zero(expr: sp.Expr) -> bool:
     """Whether ``expr`` simplifies to 0 (exact comparison of two derivations by their difference)."""
-    return sp.simplify(expr) == 0
+    return bool(sp.simplify(expr) == 0)
 
 
 def maximise(bound: sp.Expr, var: sp.Symbol = alpha) -> tuple[sp.Expr, sp.Expr]:
