@@ -18,6 +18,7 @@ performance". They are not the objective the clipped, H-step simulator optimises
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numba
 import numpy as np
@@ -97,14 +98,14 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
 
     # ------------------------------------------------------------------ settings
     @classmethod
-    def thesis_1d(cls, **overrides: object) -> LQG:
+    def thesis_1d(cls, **overrides: Any) -> LQG:
         """The one-dimensional task of Section 5.1 with the settings of SETTINGS.md."""
-        return cls(**{"dim": 1, "gamma": 0.9, "horizon": 20, **overrides})  # type: ignore[arg-type]
+        return cls(**{"dim": 1, "gamma": 0.9, "horizon": 20, **overrides})
 
     @classmethod
-    def thesis_2d(cls, **overrides: object) -> LQG:
+    def thesis_2d(cls, **overrides: Any) -> LQG:
         """The two-dimensional task of Section 5.2.1 as printed (Q = R = I, gamma = 0.95)."""
-        return cls(**{"dim": 2, "gamma": 0.95, "horizon": 20, **overrides})  # type: ignore[arg-type]
+        return cls(**{"dim": 2, "gamma": 0.95, "horizon": 20, **overrides})
 
     # ------------------------------------------------------------ bound constants
     @property
