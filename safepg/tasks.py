@@ -5,7 +5,7 @@ may also offer fast paths, each a Protocol of one method that the task's class d
 inheriting it:
 
 * :class:`GradientBatch`: a batch's gradient samples and returns in one fused call;
-* :class:`GradientBatchMaxima`: the same and the batch's measured R and M_phi;
+* :class:`GradientBatchConstants`: the same and the batch's measured R and M_phi;
 * :class:`MeasuredReturns`: the per-trajectory performance the loops record as J_hat;
 * :class:`Performance` / :class:`PerformanceBatch`: the closed-form J;
 * :class:`ActionDimension`: the number of action dimensions (else 1).
@@ -55,10 +55,10 @@ class GradientBatch(Protocol):
         ...
 
 
-class GradientBatchMaxima(Protocol):
+class GradientBatchConstants(Protocol):
     """:class:`GradientBatch` plus the batch's measured (R, M_phi): its largest |reward| and |feature|."""
 
-    def gradient_batch_maxima(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None,
+    def gradient_batch_constants(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None,
                               estimator: str = "gpomdp", baseline: bool = True, score_action: str = "clipped",
                               ) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
         """Samples, returns and (R, M_phi) of one batch."""
@@ -90,7 +90,7 @@ class PerformanceBatch(Protocol):
 
 
 #: The optional methods, by the Protocol that declares each.
-METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchMaxima: "gradient_batch_maxima",
+METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
                                  MeasuredReturns: "measured_returns", Performance: "performance",
                                  PerformanceBatch: "performance_batch"}
 
@@ -100,7 +100,7 @@ class Hooks:
     """A task's fast paths, bound to the task (None where it has none)."""
 
     gradient_batch: Callable[..., tuple[np.ndarray, np.ndarray]] | None
-    gradient_batch_maxima: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
+    gradient_batch_constants: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
     measured_returns: Callable[[Trajectories], np.ndarray] | None
     performance: Callable[[Any, Any], float] | None
     performance_batch: Callable[[np.ndarray, Any], np.ndarray] | None
@@ -159,5 +159,5 @@ def task_hooks(task: Task) -> Hooks:
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
 
 
-__all__ = ["ActionDimension", "GradientBatch", "GradientBatchMaxima", "Hooks", "MeasuredReturns", "Performance",
+__all__ = ["ActionDimension", "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns", "Performance",
            "PerformanceBatch", "Task", "task_hooks"]

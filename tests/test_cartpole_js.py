@@ -86,7 +86,7 @@ def test_gradient_samples_match_the_kernel(task, estimator, baseline, score, tmp
     n, seed, sigma = 1500, 21, 1.0
     theta = THETA_STAR if task.pole_length == 2 else np.array([0.2, 0.8, 12.0, 3.0])
     policy = LinearGaussianPolicy(theta.reshape(1, 4), sigma)
-    samples, lengths, found = task.gradient_batch_maxima(policy, n, np.random.default_rng(seed), estimator, baseline,
+    samples, lengths, found = task.gradient_batch_constants(policy, n, np.random.default_rng(seed), estimator, baseline,
                                                           score)
     U, Z = replay_draws(seed, [n], 4, task.horizon)
     q = {"task": cartpole_task_data(task), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": 4,

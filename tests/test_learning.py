@@ -249,7 +249,7 @@ def _first_batch(env, theta0, n, seed):
 def test_n_first_sets_only_the_first_batch():
     kw = dict(error=ErrorModel("bernstein", range="empirical"), budget=20_000)
     rec = adaptive_pg(ENV, batches=Batches(n_min=10, first=1000), rng=np.random.default_rng(3), **kw)
-    assert rec.batch_size[0] == 1000 and rec.config["n_first"] == 1000
+    assert rec.batch_size[0] == 1000 and rec.config["method"]["batches"]["first"] == 1000
     # The rest follows N* clipped to [n_min, n_max]; without n_first the first batch is n_min.
     assert 1000 not in rec.batch_size[1:-1]
     default = adaptive_pg(ENV, batches=Batches(n_min=10), rng=3, **kw)
@@ -315,21 +315,16 @@ def test_update_at_target_updates_before_stopping():
     assert kept.reached_target and updated.reached_target and kept.iterations == updated.iterations == 1
     assert kept.theta[-1] == kept.theta[0] and updated.theta[-1] != updated.theta[0]
     np.testing.assert_allclose(updated.theta[-1] - updated.theta[0], 1e-3 * updated.grad[0])
-    assert updated.config["update_at_target"] is True and "update_at_target" not in kept.config
+    assert updated.config["method"]["target"]["update"] is True and kept.config["method"]["target"]["update"] is False
 
 
-def test_run_config_passes_the_options_and_keeps_unset_keys():
+def test_run_config_passes_the_options_and_hashes_its_definition():
     from safepg.options import Adaptive, Vanilla
     from safepg.runner import RESULTS_VERSION, RunConfig
 
     plain = RunConfig("a", budget=2000)
-    # The key of a config without the departures is the one it had before they existed: the
-    # hash of the flat fields the config had then, and the results version.
-    before = {"algorithm": "adaptive", "env": "lqg1d", "theta0": [0.0], "sigma": 1.0, "estimator": "gpomdp",
-              "baseline": True, "bound": "chebyshev", "delta": 0.95, "empirical_range": False, "n_min": 100,
-              "n_max": 500_000, "step": "scalar", "budget": 2000, "score_action": "clipped"}
-    assert plain.fields() == before
-    blob = json.dumps([before, RESULTS_VERSION], sort_keys=True)
+    # The key hashes the whole definition and the results version, nothing else.
+    blob = json.dumps([plain.definition(), RESULTS_VERSION], sort_keys=True)
     assert plain.key() == hashlib.sha256(blob.encode()).hexdigest()[:16]
     opts = RunConfig("a", budget=2000, method=Adaptive(batches=Batches(first=500), departures=Departures(
         batch_constants=True, maxima=True, unguarded_step=True)))
@@ -337,8 +332,9 @@ def test_run_config_passes_the_options_and_keeps_unset_keys():
     assert len({plain.key(), opts.key(), first100.key()}) == 3
     rec = opts.run(0)
     assert rec.batch_size[0] == 500
-    assert {k: rec.config[k] for k in ("n_first", "constants", "statistics", "step_when_unsafe")} == {
-        "n_first": 500, "constants": "batch", "statistics": "max", "step_when_unsafe": True}
+    assert rec.config["method"]["batches"]["first"] == 500
+    assert rec.config["method"]["departures"] == {"type": "Departures", "batch_constants": True, "maxima": True,
+                                                  "unguarded_step": True}
     # An option of the other method cannot be given at all; a method must be one of the two.
     with pytest.raises(TypeError):
         Vanilla(100, FixedStep(1e-3), batches=Batches(first=200))  # type: ignore[call-arg]

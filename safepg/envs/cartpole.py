@@ -69,7 +69,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, GradientBatch, GradientBatchMaxima, MeasuredReturns
+from safepg.tasks import ActionDimension, GradientBatch, GradientBatchConstants, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -189,7 +189,7 @@ def _check_integrator(integrator: str) -> None:
 
 
 @dataclass(frozen=True)
-class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimension):
+class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension):
     r"""The continuous cart-pole task of Section 5.3, simulated N carts at a time.
 
     Parameters
@@ -522,7 +522,7 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
         samples, returns, _ = self._fused_batch(policy, n, rng, estimator, baseline, score_action, peaks=False)
         return samples, returns
 
-    def gradient_batch_maxima(
+    def gradient_batch_constants(
         self,
         policy: LinearGaussianPolicy,
         n: int,

@@ -136,6 +136,11 @@ class GymTask(MeasuredReturns, ActionDimension):
     reset_options : dict, optional
         ``options`` of every episode's ``reset`` (e.g. Pendulum-v1's
         ``{"x_init": 0.3, "y_init": 0.3}``, the half-widths of its initial angle and speed).
+    name, features_name : str, optional
+        The names a factory ``env`` and the feature map enter a stored run's definition by
+        (:meth:`definition`). A function defined at the top of a module needs none (its
+        ``module:qualname`` is its name); a lambda or a nested function does, and its name
+        must change whenever the function does: the stored runs are found by it.
 
     Raises
     ------
@@ -186,6 +191,8 @@ class GymTask(MeasuredReturns, ActionDimension):
         measure: Literal["discounted", "undiscounted"] = "discounted",
         env_kwargs: dict[str, Any] | None = None,
         reset_options: dict[str, Any] | None = None,
+        name: str | None = None,
+        features_name: str | None = None,
     ) -> None:
         try:
             from gymnasium import spaces
@@ -220,6 +227,8 @@ class GymTask(MeasuredReturns, ActionDimension):
         else:
             raise ValueError(f"env must be a gymnasium id or a factory of environments, got {env!r}")
         self._source = env
+        self.name = name
+        self.features_name = features_name
         self._env_name = env if isinstance(env, str) else getattr(env, "__qualname__", repr(env))
 
         first = self._make()
@@ -397,6 +406,42 @@ class GymTask(MeasuredReturns, ActionDimension):
             e.close()
         self._pool = []
         self._vec = None
+
+    def definition(self) -> dict[str, Any]:
+        """The keyword arguments that make this task again: what a stored run's key hashes.
+
+        An id enters as ``env``, a factory as ``env_factory``: its ``name``, else its
+        ``module:qualname``; the feature map likewise (``features_name``).
+
+        Raises
+        ------
+        safepg.definition.UnnamedError
+            The factory or the feature map is a lambda or a nested function without a name.
+        """
+        from safepg.definition import function_name
+
+        source: dict[str, Any]
+        if isinstance(self._source, str):
+            kwargs = {k: v for k, v in self.env_kwargs.items() if k != "max_episode_steps" or v != self.horizon}
+            source = {"env": self._source, "env_kwargs": kwargs or None}
+        else:
+            source = {"env_factory": self.name or function_name(self._source)}
+        features = None if self._features is None else self.features_name or function_name(self._features)
+        return {**source, "horizon": self.horizon, "gamma": self.gamma, "reward_bound": self._reward_bound,
+                "feature_bound": self._feature_bound, "action_volume": self._action_volume,
+                "action_bound": self._action_bound, "features": features, "horizon_term": self.horizon_term,
+                "measure": self.measure, "reset_options": self.reset_options}
+
+    @classmethod
+    def from_definition(cls, *, env: str | None = None, env_factory: str | None = None, features: str | None = None,
+                        **kwargs: Any) -> GymTask:
+        """The task :meth:`definition` describes (factories and feature maps imported by name)."""
+        from safepg.definition import import_name
+
+        if (env is None) == (env_factory is None):
+            raise ValueError("exactly one of env and env_factory must be given")
+        source = env if env is not None else import_name(str(env_factory))
+        return cls(source, features=None if features is None else import_name(features), **kwargs)
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle without the environments (for process pools); they are made again on use."""

@@ -96,6 +96,13 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
         mats = tuple(_as_matrix(getattr(self, k), self.dim, k) for k in "ABQR")
         object.__setattr__(self, "_mats", mats)
 
+    def definition(self) -> dict[str, Any]:
+        """The fields that make this task, each matrix written out (``A=1.0`` and ``A=[[1.0]]``
+        are one task): what a stored run's key hashes (:mod:`safepg.definition`)."""
+        A, B, Q, R = self._mats
+        return {"dim": self.dim, "gamma": self.gamma, "horizon": self.horizon, "state_bound": self.state_bound,
+                "action_bound": self.action_bound, "A": A, "B": B, "Q": Q, "R": R, "clip": self.clip}
+
     # ------------------------------------------------------------------ settings
     @classmethod
     def thesis_1d(cls, **overrides: Any) -> LQG:

@@ -32,6 +32,8 @@ from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BASELINE_CAP, SWE
 LQG2D_GAMMA = 0.9
 #: Tasks of the reproduction beyond the core's named ones, by the name their runs are keyed on.
 THESIS_ENVS = {"lqg2d-gamma0.9": partial(LQG.thesis_2d, gamma=LQG2D_GAMMA)}
+#: That task, as the Section 5.2 configurations hold it.
+LQG2D_TASK = THESIS_ENVS["lqg2d-gamma0.9"]()
 
 
 def make_env(name: str) -> Any:
@@ -223,7 +225,7 @@ _PRINTED_THETA_COORDINATE = [[-0.0275, 0.0], [0.0, -0.0274]]
 
 def _figures_5_5_5_6() -> Experiment:
     error = ErrorModel("chebyshev", 0.95)
-    configs = tuple(RunConfig(kind, method=Vanilla(2000, SafeStep(kind, error)), env="lqg2d-gamma0.9",
+    configs = tuple(RunConfig(kind, method=Vanilla(2000, SafeStep(kind, error)), task=LQG2D_TASK,
                               theta0=(0.0,) * 4) for kind in ("scalar", "coordinate"))
     thesis = {"scalar": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_SCALAR},
               "coordinate": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_COORDINATE}}
@@ -233,7 +235,7 @@ def _figures_5_5_5_6() -> Experiment:
 
 
 def _table_5_3() -> Experiment:
-    task = partial(RunConfig, env="lqg2d-gamma0.9", theta0=(0.0,) * 4)
+    task = partial(RunConfig, task=LQG2D_TASK, theta0=(0.0,) * 4)
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
                task("N=1000", method=Vanilla(1000, FixedStep(1e-6))),
                task("N=100", method=Vanilla(100, FixedStep(1e-6))))
@@ -254,7 +256,7 @@ _BASELINE_CAP = 4000 * 400
 
 
 def _cartpole_baseline() -> Experiment:
-    cfg = RunConfig("baseline", method=Vanilla(4000, FixedStep(0.01), target=Target(195.0)), env="cartpole",
+    cfg = RunConfig("baseline", method=Vanilla(4000, FixedStep(0.01), target=Target(195.0)), task="cartpole",
                     theta0=(0.0,) * 4, budget=_BASELINE_CAP)
     return Experiment("cartpole-baseline", "Cart-pole, 1 m pole: vanilla G(PO)MDP with alpha = 0.01 and "
                       "N = 4000 from theta = 0 until a batch's average return reaches 195 (Section 5.3).",
@@ -262,7 +264,7 @@ def _cartpole_baseline() -> Experiment:
 
 
 def _table_5_4() -> Experiment:
-    task = partial(RunConfig, env="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
+    task = partial(RunConfig, task="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
                task("N=4000", method=Vanilla(4000, FixedStep(0.01))))
     thesis = {"adaptive": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301},
@@ -280,7 +282,7 @@ def _sweep_baselines() -> list[Experiment]:
     out = []
     for st in CARTPOLE_SWEEP.values():
         if st.task and st.warm_start is None:
-            cfg = replace(base.configs[0], env=st.env(doubled=False, constants=False), budget=SWEEP_BASELINE_CAP)
+            cfg = replace(base.configs[0], task=st.env(doubled=False, constants=False), budget=SWEEP_BASELINE_CAP)
             out.append(replace(base, name=st.baseline_experiment, configs=(cfg,), seeds=SWEEP_SEEDS,
                                description=f"Cart-pole sweep: the baseline search with {st.label} "
                                            f"(capped at {SWEEP_BASELINE_CAP // 4000} iterations)."))
@@ -295,9 +297,9 @@ def _cartpole_sweep() -> Experiment:
         if not st.doubled:
             continue
         common = dict(warm_start=st.baseline_experiment, budget=SWEEP_BUDGET)
-        configs.append(replace(adaptive, name=f"{st.key}:adaptive", env=st.env(doubled=True), **common))
+        configs.append(replace(adaptive, name=f"{st.key}:adaptive", task=st.env(doubled=True), **common))
         if not st.constants or st.task:  # a constants-only setting shares the default's vanilla run
-            configs.append(replace(vanilla, name=f"{st.key}:N=4000", env=st.env(doubled=True, constants=False),
+            configs.append(replace(vanilla, name=f"{st.key}:N=4000", task=st.env(doubled=True, constants=False),
                                    **common))
     # Every setting is held against Table 5.4 as printed (report --json shows them side by side).
     thesis = {c.name: t54.thesis["adaptive" if c.algorithm == "adaptive" else "N=4000"] for c in configs}
@@ -396,7 +398,7 @@ def _figures_5_1_5_2_authors() -> Experiment:
 def _cartpole_baseline_authors() -> Experiment:
     base = _cartpole_baseline()
     search = base.configs[0]
-    cfg = replace(search, env=_authors_cartpole(doubled=False),
+    cfg = replace(search, task=_authors_cartpole(doubled=False),
                   method=replace(search.method, target=Target(195.0, update=True)))
     return replace(base, name="cartpole-baseline-authors", configs=(cfg,), rules="authors",
                    description="The cart-pole baseline search on the authors' task (12 deg, undiscounted return): "
@@ -408,7 +410,7 @@ def _table_5_4_authors(theta_star: bool = False) -> Experiment:
     # Both runs as long as the authors' adaptive run, the window their table averages over.
     start = (dict(theta0=tuple(float(v) for v in cartpole_theta_star())) if theta_star
              else dict(warm_start="cartpole-baseline-authors"))
-    task = partial(RunConfig, env=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET, **start)
+    task = partial(RunConfig, task=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET, **start)
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER, batches=Batches(n_min=10, first=1000),
                                                 departures=replace(AUTHORS_DEPARTURES, batch_constants=True))),
                task("N=4000", method=Vanilla(4000, FixedStep(0.01, "coordinate"))))
@@ -422,11 +424,9 @@ def _table_5_4_authors(theta_star: bool = False) -> Experiment:
 
 
 def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
-    """``exp`` with each config's task factory and the key of the run it warm-starts from."""
+    """``exp`` with the key of the run each config warm-starts from."""
     configs = []
     for c in exp.configs:
-        if c.env in THESIS_ENVS:
-            c = replace(c, env_factory=THESIS_ENVS[c.env])
         if c.warm_start is not None:
             c = replace(c, warm_start_key=registry[c.warm_start].single_config().key())
         configs.append(c)

@@ -49,7 +49,7 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
     method = cfg.method
     if not isinstance(method, Adaptive):
         raise ValueError(f"cfg must be an adaptive run, got algorithm={cfg.algorithm!r}")
-    task = cfg.make_env()
+    task = cfg.make_task()
     simulated, written = task.gamma, getattr(task, "constants_gamma", None)
     one_discount = written is None or written == simulated
     from_bounds, guarded, per_component = method.departures.assumptions()

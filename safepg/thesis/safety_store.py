@@ -163,8 +163,8 @@ def table_5_4_runs(records: Any, their_runs: Any, window: int) -> dict[str, Meas
     """
     from safepg.thesis.experiments import get_experiment
 
-    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_env()
-    text_task = get_experiment("table-5.4").config("adaptive").make_env()  # gamma = 0.99, 41.8 degrees
+    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_task()
+    text_task = get_experiment("table-5.4").config("adaptive").make_task()  # gamma = 0.99, 41.8 degrees
     runs = {"authors' adaptive run": (task, [their_runs["adaptive"]["theta"]], MC_LOOKS),
             "authors' fixed-step run": (task, [their_runs["fixed"]["theta"][:window]], MC_LOOKS)}
     for name, setting, t in (("table-5.4-authors", "ours, their settings", task),

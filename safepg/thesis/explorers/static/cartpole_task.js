@@ -86,7 +86,7 @@
    * states (s[i * n + j]); src.step(z, live, 1, t, idx) the normals of the live episodes
    * (idx: their indices in the batch). Returns [R, M_phi] measured on the batch: 1 and the
    * largest |state component| visited (initial and final states included), as
-   * CartPole.gradient_batch_maxima.
+   * CartPole.gradient_batch_constants.
    */
   CartpoleBatch.prototype.run = function (theta, sigma, n, opt, src) {
     const task = this.task, H = this.H, ph = physics(task);
