@@ -56,6 +56,7 @@ from safepg.meta import (
 )
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
+from safepg.record import on_trajectories
 from safepg.trajectories import Trajectories
 
 #: The package's version.
@@ -88,6 +89,7 @@ __all__ = [
     "n_star_closed_form",
     "n_star_search",
     "n_zero",
+    "on_trajectories",
     "optimal_batch_size",
     "penalty_constant",
     "reinforce",

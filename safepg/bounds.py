@@ -177,3 +177,7 @@ def error_bound(
     if bound == "hoeffding":
         return hoeffding(delta, grad_range)
     return bernstein(delta, float(np.var(samples, ddof=1)) if variance is None else float(variance), grad_range)
+
+
+__all__ = ["BOUNDS", "Bound", "ErrorBound", "Range", "bernstein", "chebyshev", "check_delta", "check_range",
+           "error_bound", "gpomdp_variance_factor", "gradient_range_bound", "hoeffding", "reinforce_variance_factor"]

@@ -117,3 +117,6 @@ class TaskConstants:
             sigma=float(sigma),
             horizon_term=getattr(task, "horizon_term", "effective"),
         )
+
+
+__all__ = ["BoundedTask", "HORIZON_TERMS", "TaskConstants"]

@@ -139,3 +139,7 @@ def gradient_samples(
         return reinforce(scores, batch.rewards, batch.gamma, baseline)
     check_estimator(estimator)
     return gpomdp(scores, batch.rewards, batch.gamma, baseline)
+
+
+__all__ = ["ESTIMATORS", "Estimator", "SCORE_ACTIONS", "ScoreAction", "check_estimator", "check_score_action", "gpomdp",
+           "gpomdp_baseline", "gradient_samples", "reinforce", "reinforce_baseline", "trajectory_scores"]

@@ -206,3 +206,8 @@ def optimal_batch_size(
     elif math.isinf(n):
         raise ValueError("n_max must be given when the gradient estimate is 0: N* is then infinite")
     return int(max(n_min, n))
+
+
+__all__ = ["ALPHA_STAR_FACTOR", "N_STAR_FACTOR", "coordinate_step", "guaranteed_improvement", "n_star_bernstein_root",
+           "n_star_closed_form", "n_star_search", "n_zero", "optimal_batch_size", "penalty_constant", "scalar_step",
+           "upsilon"]

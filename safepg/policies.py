@@ -124,3 +124,6 @@ class LinearGaussianPolicy:
         diff = portable.matmul(actions - self.mean(features), self.precision)  # precision is symmetric
         outer: np.ndarray = diff[..., :, None] * features[..., None, :]
         return outer.reshape(features.shape[:-1] + (self.gain.size,))
+
+
+__all__ = ["LinearGaussianPolicy", "check_sigma"]

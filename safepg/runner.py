@@ -177,12 +177,13 @@ class RunConfig:
         return rec
 
 
-def run_path(folder: Path, cfg: RunConfig, seed: int) -> Path:
+def run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
     """Where seed ``seed`` of ``cfg`` is stored in a group's folder."""
-    return folder / cfg.name / f"seed-{seed}.npz"
+    return Path(folder) / cfg.name / f"seed-{seed}.npz"
 
 
-def stored_run(folder: Path, cfg: RunConfig, seed: int, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
+def stored_run(folder: str | os.PathLike[str], cfg: RunConfig, seed: int,
+               on_damaged: OnDamaged = "warn") -> LearningRecord | None:
     """Seed ``seed`` of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
 
     A damaged file is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
@@ -190,7 +191,7 @@ def stored_run(folder: Path, cfg: RunConfig, seed: int, on_damaged: OnDamaged = 
     return load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
 
 
-def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, seed: int) -> None:
+def store_run(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
     """Stamp ``rec`` with the key :func:`stored_run` checks and save it (in the calling process,
     so the stamp is this process's key whatever the worker's copy of the definitions)."""
     rec.config["run_key"] = cfg.key()
@@ -214,7 +215,7 @@ def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
     return i, _compute(cfg, seed, theta0, single_thread)
 
 
-def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
+def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
                  on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
     """Finished runs of ``configs`` by config name (missing seeds are left out).
 
@@ -239,7 +240,7 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
 def run_configs(
     configs: Sequence[RunConfig],
     seeds: int,
-    folder: Path,
+    folder: str | os.PathLike[str],
     starts: Mapping[str, Sequence[np.ndarray]] | None = None,
     jobs: int = -1,
     progress: bool = True,
@@ -272,6 +273,7 @@ def run_configs(
     """
     from joblib import Parallel, delayed, effective_n_jobs
 
+    folder = Path(folder)
     if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
         raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
     starts = starts or {}
@@ -314,3 +316,7 @@ def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
                        "results_version": RESULTS_VERSION})
     with open(folder / TIMING_FILE, "a") as f:
         f.write(line + "\n")
+
+
+__all__ = ["RESULTS_VERSION", "RunConfig", "TIMING_FILE", "load_configs", "make_env", "record_timing", "run_configs",
+           "run_path", "store_run", "stored_run"]

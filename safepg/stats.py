@@ -158,3 +158,6 @@ def t_quantile(df: int, tails: str) -> float:
             else:
                 hi = mid
         return float(mpmath.sqrt(df * (1 - lo) / lo))
+
+
+__all__ = ["mean_ci95", "prediction_band95", "prediction_interval95", "seed_summary95", "t_quantile", "t_quantile_975"]

@@ -54,3 +54,6 @@ class Trajectories:
         """Per-trajectory discounted return sum_t gamma^t r_t, shape (N,)."""
         returns: np.ndarray = np.sum(self.rewards * self.discounts(), axis=1)  # not BLAS (safepg.portable)
         return returns
+
+
+__all__ = ["Trajectories"]

@@ -4,13 +4,12 @@ import numpy as np
 import pytest
 
 from safepg.learning import LearningRecord
+from safepg.record import on_trajectories
 from safepg.thesis.analysis import (
     by_iteration,
     markdown_table,
     mean_band,
-    measured_on_grid,
     one_cell_spread,
-    performance_on_grid,
     table_5_2,
     table_upsilon,
 )
@@ -22,9 +21,9 @@ def rec(batch, J):
                           np.array(J[:-1]) + 1, np.zeros((I, 1)), np.zeros(I), np.ones(I, bool))
 
 
-def test_performance_on_grid_holds_each_J_for_its_batch():
+def test_on_trajectories_holds_each_J_for_its_batch():
     r = rec([10, 20, 5], [-5.0, -4.0, -3.0, -2.5])
-    got = performance_on_grid([r], np.array([1, 10, 11, 30, 31, 35, 36]))[0]
+    got = on_trajectories([r], np.array([1, 10, 11, 30, 31, 35, 36]))[0]
     np.testing.assert_array_equal(got, [-5, -5, -4, -4, -3, -3, np.nan])
 
 
@@ -89,9 +88,9 @@ def test_simulated_objective_optimum_differs_from_closed_form():
     assert -0.70 < best < -0.60 and abs(f(best) - (-9.56)) < 0.05
 
 
-def test_measured_on_grid_holds_each_batch_average():
+def test_on_trajectories_holds_each_batch_average():
     r = rec([10, 20], [-5.0, -4.0, -3.0])  # J_hat = J[:-1] + 1
-    got = measured_on_grid([r], np.array([1, 10, 11, 30, 31]))[0]
+    got = on_trajectories([r], np.array([1, 10, 11, 30, 31]), "J_hat")[0]
     np.testing.assert_array_equal(got, [-4, -4, -3, -3, np.nan])
 
 

@@ -17,6 +17,7 @@ import pytest
 from safepg import runner, store
 from safepg.cli import main
 from safepg.learning import LearningRecord
+from safepg.options import FixedStep, Vanilla
 from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
 
@@ -365,3 +366,13 @@ def test_equal_budgets_put_the_smallest_fixed_batches_first(tmp_path, monkeypatc
     monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.name), compute(c, *a))[1])
     es.run_experiment(e, jobs=1, root=tmp_path, progress=False)
     assert order == ["N=100", "N=1000", "adaptive"]
+
+
+@pytest.mark.parametrize("as_text", [True, False])
+def test_a_folder_may_be_a_str_or_a_path(tmp_path, as_text):
+    cfg = runner.RunConfig("tiny", method=Vanilla(10, FixedStep(1e-3)), budget=40)
+    folder = str(tmp_path / "group") if as_text else tmp_path / "group"
+    recs = runner.run_configs([cfg], 2, folder, jobs=1, progress=False)
+    assert len(recs["tiny"]) == 2 and (tmp_path / "group" / "tiny" / "seed-1.npz").is_file()
+    again = runner.load_configs([cfg], 2, folder)["tiny"]
+    assert [r.config["seed"] for r in again] == [0, 1] and runner.stored_run(folder, cfg, 0) is not None

@@ -771,3 +771,7 @@ else:  # pragma: no cover
 
     def register_envs() -> None:
         """No-op without gymnasium (an optional dependency)."""
+
+
+__all__ = ["CartPole", "ContinuousCartPoleEnv", "ENV_ID", "INTEGRATORS", "NORMALISED_SCALE", "gymnasium_step",
+           "register_envs", "step_dynamics"]

@@ -376,3 +376,6 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
             kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
         out = kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
         return out
+
+
+__all__ = ["LQG"]

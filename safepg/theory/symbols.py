@@ -111,3 +111,7 @@ def maximise(bound: sp.Expr, var: sp.Symbol = alpha) -> tuple[sp.Expr, sp.Expr]:
         raise ValueError(f"bound must have exactly one provable maximiser in {var}, got {points}")
     arg = sp.factor(sp.simplify(points[0]))
     return arg, sp.factor(sp.simplify(bound.subs(var, arg)))
+
+
+__all__ = ["A_bar", "A_vol", "H", "LATEX_NAMES", "M_phi", "N", "R", "R_range", "S_N", "alpha", "b", "c", "d", "delta",
+           "eps", "f", "g", "g1", "g2", "gamma", "is_zero", "latex", "maximise", "mu_bar", "sigma", "tidy", "var", "x"]

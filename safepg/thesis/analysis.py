@@ -14,34 +14,6 @@ from safepg.learning import LearningRecord
 from safepg.thesis.authors import strict_improvement_ratio
 
 
-def performance_on_grid(records: Sequence[LearningRecord], grid: np.ndarray) -> np.ndarray:
-    """J of the policy that generated trajectory T, for T in ``grid`` (1-based), per seed.
-
-    This is the thesis's "expected performance over sample trajectories": each
-    iteration's J is held for all the trajectories of its batch (Figures 5.1, 5.2).
-    Returns an array (seeds, len(grid)); NaN past a run's last trajectory.
-    """
-    grid = np.asarray(grid)
-    out = np.full((len(records), grid.size), np.nan)
-    for i, r in enumerate(records):
-        ends = np.cumsum(r.batch_size)
-        idx = np.searchsorted(ends, grid)
-        ok = idx < r.iterations
-        out[i, ok] = r.J[idx[ok]]
-    return out
-
-
-def measured_on_grid(records: Sequence[LearningRecord], grid: np.ndarray) -> np.ndarray:
-    """Batch-average return of the batch containing trajectory T (Figure 5.9's curve)."""
-    grid = np.asarray(grid)
-    out = np.full((len(records), grid.size), np.nan)
-    for i, r in enumerate(records):
-        idx = np.searchsorted(np.cumsum(r.batch_size), grid)
-        ok = idx < r.iterations
-        out[i, ok] = r.J_hat[idx[ok]]
-    return out
-
-
 def by_iteration(records: Sequence[LearningRecord], field: str = "batch_size") -> np.ndarray:
     """A per-iteration field (e.g. batch size, step size) per seed, NaN-padded: (seeds, max I)."""
     length = max(r.iterations for r in records)

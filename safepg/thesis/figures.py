@@ -16,8 +16,9 @@ from matplotlib.figure import Figure
 from safepg.bounds import ErrorBound
 from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
+from safepg.record import on_trajectories
 from safepg.thesis import plotting
-from safepg.thesis.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
+from safepg.thesis.analysis import by_iteration, mean_band
 
 Records = Mapping[str, Sequence[LearningRecord]]
 
@@ -30,9 +31,9 @@ def _grid(records: Records, points: int = 600) -> np.ndarray:
 def _performance_panel(ax: plt.Axes, records: Records, labels: Mapping[str, str],
                        styles: Mapping[str, dict], measured: bool = False) -> None:
     grid = _grid({k: records[k] for k in labels})
-    curve = measured_on_grid if measured else performance_on_grid
+    field = "J_hat" if measured else "J"
     for name, label in labels.items():
-        mean, lo, hi = mean_band(curve(records[name], grid))
+        mean, lo, hi = mean_band(on_trajectories(records[name], grid, field))
         st = styles[name]
         ax.plot(grid, mean, label=label, **st)
         ax.fill_between(grid, lo, hi, color=st.get("color"), alpha=0.2, linewidth=0)

@@ -19,9 +19,9 @@ from matplotlib.figure import Figure
 
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
+from safepg.record import on_trajectories
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, plotting
-from safepg.thesis.analysis import measured_on_grid, performance_on_grid
 from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, cartpole_runs, lqg2d_runs
 
 # ---------------------------------------------------------------- Section 5.1: 1-D fixed-step runs
@@ -156,7 +156,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
     mean and 95% prediction band) and the authors' plotted curve.
 
     ``processing="text"``: each seed's closed-form J of the policy that generated trajectory T
-    (:func:`~safepg.thesis.analysis.performance_on_grid`), the band for a five-run mean (the caption).
+    (:func:`~safepg.record.on_trajectories`), the band for a five-run mean (the caption).
     ``processing="authors"``: each seed through the authors' :func:`~safepg.thesis.authors.grid_curve`
     (their ``scaleData.m``), the band for one run, as their curve is. ``runs`` sets the band's number
     of runs otherwise (to test one choice at a time).
@@ -168,7 +168,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
                                           error.delta)]
     grid = curve["trajectories"].astype(np.int64)
     if processing == "text":
-        values, n = performance_on_grid(records[config.name], grid), FIGURES_51_52_RUNS
+        values, n = on_trajectories(records[config.name], grid), FIGURES_51_52_RUNS
     else:
         mapped = [authors.grid_curve(r.batch_size, r.J[:-1]) for r in records[config.name]]
         if any(not np.array_equal(x, grid) for x, _ in mapped):
@@ -457,7 +457,7 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     grid = np.asarray(grid)
     ours = {}
     for name, recs in records.items():
-        values = measured_on_grid(recs, grid)
+        values = on_trajectories(recs, grid, "J_hat")
         mean, lo, hi = seed_band95(values)
         one = np.sum(~np.isnan(values), axis=0) < 2  # no band drawn where fewer than two seeds remain
         lo[one] = hi[one] = np.nan

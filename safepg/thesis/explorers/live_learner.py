@@ -44,8 +44,9 @@ from safepg import portable
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, learn
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, Vanilla
+from safepg.record import on_trajectories
 from safepg.thesis import plotting
-from safepg.thesis.analysis import by_iteration, mean_band, performance_on_grid
+from safepg.thesis.analysis import by_iteration, mean_band
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
@@ -127,7 +128,7 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
             "delta": m.error.delta, "score": m.gradient.score_action, "seeds": len(recs), "name": cfg.name,
             "iteration": (keep + 1).tolist(), "start": _round(start_mean[keep]),
             "batch_size": _round(n[keep]), "alpha": _round(a[keep]),
-            "J": _round(mean_band(performance_on_grid(recs, grid))[0]), "budgets": per_budget}
+            "J": _round(mean_band(on_trajectories(recs, grid))[0]), "budgets": per_budget}
 
 
 def _matches_1d_table(cfg: Any) -> bool:
@@ -375,7 +376,7 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         plots["alpha"]["series"].append({"x": (keep + 1).tolist(), "y": rec.alpha[keep].tolist(), **style})
         T = np.unique(np.maximum(1, np.round(1 + np.arange(data["points"]) * (budget - 1) / (data["points"] - 1))))
         T = T[T <= rec.trajectories].astype(np.int64)
-        plots["J"]["series"].append({"x": T.tolist(), "y": performance_on_grid([rec], T)[0].tolist(), **style})
+        plots["J"]["series"].append({"x": T.tolist(), "y": on_trajectories([rec], T)[0].tolist(), **style})
         values[name] = run_summary(rec, still_tolerance(data, float(rec.theta[0, 0])))
     return {"plots": plots, "values": values, "text": summary_text(values, data, budget)}
 
