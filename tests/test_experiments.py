@@ -120,6 +120,10 @@ def test_cli_list_run_report(root, capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "table-5.1" in out and "table-5.2" in out
+    assert main(["list", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)["table-5.3"]["configs"]["adaptive"]
+    cfg = ex.get_experiment("table-5.3").config("adaptive")
+    assert listed == {"key": cfg.key(), "definition": cfg.definition()}
     assert main(["run", "table-5.1", "--seeds", "1", "--budget", "20000", "--jobs", "2", "--quiet"]) == 0
     capsys.readouterr()
     assert main(["report", "table-5.1", "--seeds", "1", "--budget", "20000", "--json"]) == 0

@@ -1,5 +1,6 @@
 """Learning loops: determinism, record invariants, metrics, bad input."""
 
+import argparse
 import hashlib
 import json
 import subprocess
@@ -13,7 +14,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
-from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.tasks import MeasuredReturns
 
@@ -156,7 +157,7 @@ def test_nan_gradient_raises():
 
 
 def test_cli_learn_json(capsys):
-    assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--empirical-range",
+    assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--range", "empirical",
                  "--quiet", "--seed", "3"]) == 0
     out = json.loads(capsys.readouterr().out)
     for key in ("iterations", "trajectories", "theta", "J_initial", "J_star", "J_final", "J_at",
@@ -166,17 +167,40 @@ def test_cli_learn_json(capsys):
     assert out["J_initial"] == pytest.approx(-56.667, abs=1e-3)
     assert out["J_star"] == pytest.approx(-13.207, abs=1e-3)
     assert len(out["batch_sizes"]) == out["iterations"]
+    # The run's definition, in the option objects' names.
+    assert out["config"]["method"]["error"] == {"type": "ErrorModel", "bound": "bernstein", "delta": 0.95,
+                                                "range": "empirical"}
 
 
 def test_cli_vanilla(capsys):
-    assert main(["learn", "--fixed-alpha", "1e-4", "--fixed-n", "100", "--budget", "2000",
+    assert main(["learn", "--alpha", "1e-4", "--batch-size", "100", "--budget", "2000",
                  "--theta0", "-0.55", "--sigma", "0.5", "--quiet"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["batch_sizes"] == [100] * 20
+    assert out["config"]["method"]["step"] == {"type": "FixedStep", "alpha": 1e-4, "kind": "scalar"}
+
+
+@pytest.mark.parametrize("args,method", [
+    (["--first", "300", "--maxima", "--unguarded-step", "--no-baseline"],
+     Adaptive(Gradient(baseline=False), batches=Batches(first=300), departures=Departures(maxima=True,
+                                                                                          unguarded_step=True))),
+    (["--batch-size", "200", "--safe-step", "coordinate", "--bound", "hoeffding", "--range", "1280"],
+     Vanilla(200, SafeStep("coordinate", ErrorModel("hoeffding", 0.95, 1280.0)))),
+    (["--batch-size", "200", "--alpha", "0.01", "--kind", "coordinate", "--target", "-20", "--update"],
+     Vanilla(200, FixedStep(0.01, "coordinate"), target=Target(-20.0, True))),
+])
+def test_cli_flags_are_the_option_objects_fields(args, method):
+    from safepg.cli import _learn_parser, _method
+
+    parser = argparse.ArgumentParser()
+    _learn_parser(parser.add_subparsers())
+    assert _method(parser.parse_args(["learn", *args])) == method
 
 
 @pytest.mark.parametrize("args,word", [(["--delta", "1.5"], "delta"), (["--sigma", "0"], "sigma"),
-                                       (["--n-min", "10", "--n-max", "5"], "n_min")])
+                                       (["--n-min", "10", "--n-max", "5"], "n_min"),
+                                       (["--alpha", "0.1"], "--batch-size"),
+                                       (["--batch-size", "100"], "--alpha")])
 def test_cli_bad_input_one_line_no_traceback(args, word):
     p = subprocess.run([sys.executable, "-m", "safepg", "learn", "--quiet", "--budget", "1000", *args],
                        capture_output=True, text=True)

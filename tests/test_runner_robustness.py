@@ -296,7 +296,7 @@ def test_zero_seeds_is_a_clear_error_without_traceback(tmp_path):
     (["learn", "--budget", "2.5e3.1"], "argument --budget: expected an integer"),
     (["learn", "--n-min", "0"], "argument --n-min: must be a positive integer"),
     (["learn", "--n-max", "1e5.5"], "argument --n-max: expected an integer"),
-    (["learn", "--fixed-n", "100.5", "--fixed-alpha", "1e-4"], "argument --fixed-n: expected a whole number"),
+    (["learn", "--batch-size", "100.5", "--alpha", "1e-4"], "argument --batch-size: expected a whole number"),
     (["learn", "--seed", "-1"], "argument --seed: must be a non-negative integer"),
 ])
 def test_bad_counts_name_the_parameter(tmp_path, monkeypatch, capsys, argv, message):
@@ -320,7 +320,7 @@ def test_counts_accept_exact_scientific_notation(tmp_path, monkeypatch, capsys):
 
     assert [integer(s) for s in ("1e6", "1E6", "3_000_000", "1.5e3", " 200 ", "2.0e2")] == [
         1_000_000, 1_000_000, 3_000_000, 1500, 200, 200]
-    code, out, _ = _cli(capsys, "learn", "--budget", "2e3", "--fixed-n", "1e2", "--fixed-alpha", "1e-4",
+    code, out, _ = _cli(capsys, "learn", "--budget", "2e3", "--batch-size", "1e2", "--alpha", "1e-4",
                         "--n-min", "1e2", "--n-max", "5e5", "--seed", "0e0", "--quiet")
     assert code == 0 and json.loads(out)["trajectories"] == 2000 and json.loads(out)["iterations"] == 20
     # run and report parse --budget 1e6 as 1000000 (here: nothing stored, so report says what to run).
