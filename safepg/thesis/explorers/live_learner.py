@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from safepg import portable
+from safepg.definition import to_dict
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, learn
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, Vanilla
@@ -135,8 +136,8 @@ def _matches_1d_table(cfg: Any) -> bool:
     """A stored configuration the live learner can rerun: Algorithm 4.1 on the 1-D LQG from
     theta_0 = 0, sigma = 1, with the default batch limits, range and a long enough budget."""
     m = cfg.method
-    return (isinstance(m, Adaptive) and cfg.env == "lqg1d" and tuple(cfg.theta0) == (0.0,)
-            and cfg.sigma == 1.0 and m.gradient.baseline and m.batches == Batches()
+    return (isinstance(m, Adaptive) and to_dict(cfg.make_task()) == to_dict(LQG.thesis_1d())
+            and tuple(cfg.theta0) == (0.0,) and cfg.sigma == 1.0 and m.gradient.baseline and m.batches == Batches()
             and m.departures == Departures() and m.error.theoretical_range is None and cfg.budget >= BUDGETS[-1]
             and cfg.warm_start is None)
 
