@@ -215,7 +215,7 @@ def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequen
     and the estimators share each batch's random numbers."""
     from safepg.policies import LinearGaussianPolicy
 
-    pol = LinearGaussianPolicy([[theta]], sigma)
+    pol = LinearGaussianPolicy(np.array([[theta]]), sigma)
     rng = np.random.default_rng(seed)
     out = {e: np.empty((len(batch_sizes), repeats)) for e in estimators}
     for i, n in enumerate(batch_sizes):
@@ -227,7 +227,7 @@ def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequen
     return out
 
 
-def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, seed: int = 0,
+def sample_variance(env: Any, theta: float, sigmas: Sequence[float] | np.ndarray, n: int, seed: int = 0,
                     estimators: Sequence[str] = ("reinforce", "gpomdp"),
                     baseline: bool = True) -> dict[str, np.ndarray]:
     """Per-trajectory variance of each estimator's gradient sample as sigma varies (1-D)."""
@@ -235,7 +235,7 @@ def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, see
 
     out = {e: np.empty(len(sigmas)) for e in estimators}
     for i, s in enumerate(sigmas):
-        pol = LinearGaussianPolicy([[theta]], s)
+        pol = LinearGaussianPolicy(np.array([[theta]]), s)
         for e in estimators:
             out[e][i] = env.gradient_batch(pol, n, np.random.default_rng(seed), e, baseline)[0].var(ddof=1)
     return out

@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, TypedDict
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
@@ -150,8 +151,20 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
     return fig
 
 
+class OverlaySeries(TypedDict):
+    """One curve of Figures 5.1-5.2 on the authors' grid (:func:`figure51_52_overlay_series`)."""
+
+    x: np.ndarray
+    ours_mean: np.ndarray
+    ours_lo: np.ndarray
+    ours_hi: np.ndarray
+    authors: np.ndarray
+    values: np.ndarray
+    runs: int
+
+
 def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config,
-                               processing: Processing = "text", runs: int | None = None) -> dict[str, np.ndarray]:
+                               processing: Processing = "text", runs: int | None = None) -> OverlaySeries:
     """One curve of Figures 5.1-5.2 on the authors' grid of T: ours (``values``, each seed's curve; their
     mean and 95% prediction band) and the authors' plotted curve.
 
@@ -180,7 +193,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
             "runs": runs}
 
 
-def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
+def _figure51_52_panel(ax: Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
                        colors: Mapping[str, str], labels: Mapping[str, str], processing: Processing) -> None:
     for c in configs:
         s = figure51_52_overlay_series(records, c, processing)
@@ -243,12 +256,13 @@ _LQG2D_COLORS = {"adaptive": "#7d4fb0", "adaptive-authors": "#c0392b", "N=1000":
 
 #: Our mean is drawn broad and light, their run dashed and dark on top of it, so both stay visible
 #: where they coincide.
-_LQG2D_OURS = {"linewidth": 2.6, "alpha": 0.6}
-_LQG2D_THEIRS = {"linestyle": (0, (4, 3)), "linewidth": 1.3, "zorder": 3}
+_LQG2D_OURS: dict[str, Any] = {"linewidth": 2.6, "alpha": 0.6}
+_LQG2D_THEIRS: dict[str, Any] = {"linestyle": (0, (4, 3)), "linewidth": 1.3, "zorder": 3}
 
 
 def _lqg2d_dark(key: str) -> tuple[float, float, float]:
-    return tuple(0.55 * c for c in to_rgb(_LQG2D_COLORS.get(key, "#444444")))
+    red, green, blue = to_rgb(_LQG2D_COLORS.get(key, "#444444"))
+    return 0.55 * red, 0.55 * green, 0.55 * blue
 
 
 def lqg2d_held(batch_size: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -271,10 +285,10 @@ def _lqg2d_grid(records: Mapping[str, Sequence[LearningRecord]], runs: Mapping[s
     return np.unique(np.linspace(1, total, points).astype(np.int64))
 
 
-def _lqg2d_authors_axis(ax: plt.Axes) -> None:
+def _lqg2d_authors_axis(ax: Axes) -> None:
     """A right-hand axis in the authors' units (16 times ours), for reading the printed figures."""
-    sec = ax.secondary_yaxis("right", functions=(lambda y: y * LQG2D_AUTHORS_SCALE,
-                                                 lambda y: y / LQG2D_AUTHORS_SCALE))
+    sec = ax.secondary_yaxis("right", functions=(lambda y: np.multiply(y, LQG2D_AUTHORS_SCALE),
+                                                 lambda y: np.divide(y, LQG2D_AUTHORS_SCALE)))
     sec.set_ylabel(f"authors' units ({LQG2D_AUTHORS_SCALE:g}× J)")
 
 

@@ -25,7 +25,7 @@ from safepg.envs.cartpole import CartPole
 from safepg.learning import learn
 from safepg.options import Adaptive, ErrorModel, Vanilla
 from safepg.thesis.authors import cartpole_theta_star
-from safepg.thesis.experiments import AUTHORS_DOUBLED, get_experiment
+from safepg.thesis.experiments import AUTHORS_DOUBLED, get_experiment, method_of
 from safepg.thesis.explorers.ch5_live import (
     CURVE_POINTS,
     Ch5LiveExplorer,
@@ -99,7 +99,7 @@ def cartpole_task(p: Mapping[str, Any]) -> CartPole:
 def adaptive_method(p: Mapping[str, Any]) -> Adaptive:
     """Algorithm 4.1 as the controls ``p`` set it: ``table-5.4``'s adaptive run (Bernstein with
     the empirical range) at the control's delta, with the ticked boxes' changes."""
-    method = replace(get_experiment("table-5.4").config("adaptive").method,
+    method = replace(method_of(get_experiment("table-5.4").config("adaptive"), Adaptive),
                      error=ErrorModel("bernstein", float(p["delta"]), "empirical"))
     for name, _, _, change in SETTINGS:
         if p[name]:
@@ -247,11 +247,11 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
         tasks[task_key(p)] = cartpole_task_data(cartpole_task(p))
     van = learner_options(vanilla_method())
     text = adaptive_method({"delta": 0.95, **{name: False for name, *_ in SETTINGS}})
-    base = learner_options(text)
+    text_options = learner_options(text)
     data = {"tasks": tasks, "starts": starts, "points": CURVE_POINTS, "frozen": FROZEN,
             "theta_names": list(THETA_NAMES), "theta_colors": list(THETA_COLORS), "task_boxes": list(TASK_BOXES),
             # Each box's options under the page learner's names, as far as they differ from the text's.
-            "settings": {name: {k: v for k, v in learner_options(change(text)).items() if base[k] != v}
+            "settings": {name: {k: v for k, v in learner_options(change(text)).items() if text_options[k] != v}
                          for name, _, _, change in SETTINGS},
             "vanilla": {k: van[k] for k in ("batchSize", "alpha", "step")},
             "vanilla_label": f"fixed step (N = {van['batchSize']}, alpha = {van['alpha']:g})"}

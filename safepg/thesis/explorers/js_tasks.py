@@ -135,10 +135,11 @@ def learner_options(method: Method) -> dict[str, Any]:
                 "nFirst": b.first, "constants": "batch" if d.batch_constants else "bounds",
                 "statistics": "max" if d.maxima else "component", "stepWhenUnsafe": d.unguarded_step}
     step = method.step
-    e = step.error if isinstance(step, SafeStep) else None
-    return {"algorithm": "vanilla", **out, "bound": e.bound if e else "chebyshev",
-            "empiricalRange": bool(e and e.empirical_range), "theoreticalRange": e.theoretical_range if e else None,
-            "delta": e.delta if e else 0.95, "batchSize": method.batch_size,
+    se = step.error if isinstance(step, SafeStep) else None
+    return {"algorithm": "vanilla", **out, "bound": se.bound if se else "chebyshev",
+            "empiricalRange": bool(se and se.empirical_range),
+            "theoreticalRange": se.theoretical_range if se else None,
+            "delta": se.delta if se else 0.95, "batchSize": method.batch_size,
             "alpha": step.alpha if isinstance(step, FixedStep) else None, "step": step.kind}
 
 

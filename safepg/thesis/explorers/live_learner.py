@@ -44,10 +44,11 @@ from safepg import portable
 from safepg.definition import to_dict
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, learn
-from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, Vanilla
+from safepg.options import Adaptive, Batches, Departures, FixedStep, Gradient, Vanilla
 from safepg.record import on_trajectories
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band
+from safepg.thesis.explorers.ch5_live import bound_control_error
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
@@ -337,14 +338,14 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
     gradient = Gradient(p["estimator"], p["baseline"] == "on", p["score"])
     runs = 1 if p["vanilla_n"] == "off" else 2
 
-    def report(k: int, label: str) -> Callable[[int, int], None] | bool:
+    def report(k: int, label: str) -> Callable[[int, int], object] | bool:
         """safepg's per-batch report for run k, as a fraction of all runs (False: no report)."""
         if progress is None:
             return False
         return lambda used, total: progress((k * budget + used) / (runs * budget),
                                             f"{label}: {used:,} / {total:,} trajectories")
 
-    error = ErrorModel(bound.removesuffix("-er"), float(p["delta"]), "empirical" if bound.endswith("-er") else "lemma")
+    error = bound_control_error(bound, float(p["delta"]))
     recs = {"adaptive": learn(env, Adaptive(gradient, error), 0.0, float(p["sigma"]), budget=budget,
                               rng=np.random.default_rng(seed), progress=report(0, "Algorithm 4.1"))}
     if p["vanilla_n"] != "off":

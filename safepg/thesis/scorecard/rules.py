@@ -13,7 +13,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, Literal, NamedTuple
+from typing import Any, Final, Literal, NamedTuple, Protocol
 
 import numpy as np
 
@@ -22,14 +22,14 @@ from safepg.thesis.scorecard.text import MissingValueError, fill, template_field
 #: The status of a row that fails its rule on our runs of the thesis's text and passes it, by the
 #: same rule, on our runs under the authors' settings: what their code ran where the text says
 #: something else or nothing.
-AUTHORS_STATUS = "reproduced only with the authors' unprinted settings"
+AUTHORS_STATUS: Final = "reproduced only with the authors' unprinted settings"
 #: The status of a row whose printed number is reproduced only by an error in the authors' code (their
 #: 2-D J, 16 times the expectation): their number explained, not the thesis's claim confirmed.
-AUTHORS_ERROR_STATUS = "reproduced only through an error in the authors' code"
+AUTHORS_ERROR_STATUS: Final = "reproduced only through an error in the authors' code"
 #: The status of a row whose rule holds on a run that could not have done otherwise: an improvement
 #: ratio of a run whose theta does not move (consecutive batch means then differ by noise alone, so any
 #: such run scores about 50%, or 100% when no update is taken). The agreement carries no information.
-VACUOUS_STATUS = "agrees, but carries no information"
+VACUOUS_STATUS: Final = "agrees, but carries no information"
 Status = Literal["reproduced", "reproduced only with the authors' unprinted settings",
                  "reproduced only through an error in the authors' code", "agrees, but carries no information",
                  "differs (explained)", "open"]
@@ -224,6 +224,12 @@ class MovedComponents(NamedTuple):
     authors_components: str
 
 
+class _Measured(Protocol):
+    """What a note's ``measured`` is: a NamedTuple class, whose fields name the values it quotes."""
+
+    def _asdict(self) -> dict[str, Any]: ...
+
+
 @dataclass(frozen=True)
 class Note:
     """Why a row differs (``explains=True``) or what is known about an open row.
@@ -240,7 +246,7 @@ class Note:
     page: str
     heading: str
     explains: bool = True
-    measured: type[tuple[Any, ...]] | None = None
+    measured: type[_Measured] | None = None
 
     def __post_init__(self) -> None:
         declared = set(getattr(self.measured, "_fields", ()))
@@ -249,7 +255,7 @@ class Note:
             raise MissingValueError(f"the note {self.text[:60]!r}... names {sorted(missing)}, which its measured "
                                     f"values {sorted(declared)} do not declare")
 
-    def fill(self, values: tuple[Any, ...] | None) -> str:
+    def fill(self, values: _Measured | None) -> str:
         """The note's text filled from ``values``, an instance of :attr:`measured`.
 
         Raises
@@ -263,7 +269,7 @@ class Note:
             return self.text
         if not isinstance(values, self.measured):
             raise MissingValueError(f"the note {self.text[:60]!r}... needs a {self.measured.__name__}, got {values!r}")
-        return fill(self.text, values._asdict())  # type: ignore[attr-defined]
+        return fill(self.text, values._asdict())
 
 
 #: The authors' curves of Figures 5.1 and 5.2 that leave our band under both processings.

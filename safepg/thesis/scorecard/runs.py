@@ -17,13 +17,14 @@ from safepg.learning import LearningRecord
 from safepg.options import Adaptive, FixedStep, Vanilla
 from safepg.runner import RunConfig
 from safepg.stats import prediction_interval95
-from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
+from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment, method_of
 from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.judged import (
     ci_judged,
     frozen,
     one_run_ratio,
+    overlaps_printed,
     pi_text,
     prediction,
     ratio_interval,
@@ -67,9 +68,10 @@ def _row_key(c: RunConfig) -> tuple[str, str, bool, float]:
 
 
 def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
-    m, ci = d.get("mean"), d.get("ci95")
+    m = d.get("mean")
     if m is None:
         return None, None
+    ci = d["ci95"]  # a summary with a mean has its interval (safepg.stats.mean_ci95)
     return float(m), [float(ci[0]), float(ci[1])]
 
 
@@ -171,7 +173,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
     fmt = lambda x: num(x, dec)  # noqa: E731
     lemma = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
-        if vc.method.error.theoretical_range is None:
+        if method_of(vc, Adaptive).error.theoretical_range is None:
             lemma[_row_key(vc)] = (vc, vr)
     ratios, still = [], []
     for c, r in zip(exp.configs, rep["configs"]):
@@ -194,20 +196,18 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             if authors is not None:
                 a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
                 a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
-                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar and ar["seeds"]))
+                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", overlaps_printed(th["ci95"]),
+                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar["seeds"] if ar else None))
             else:
                 a_col = _authors(exp, seeds, mean, ci, guarded,
-                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                 interval=ci, interval_text=ci_judged(ci, fmt, seeds))
+                                 overlaps_printed(th["ci95"]), interval=ci, interval_text=ci_judged(ci, fmt, seeds))
             mean, ci = _mean_ci(vr["upsilon_bar"])
             seeds = vr["seeds"]
             range_runs = RangeRuns(f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
                                    f"authors' settings {a_col.text or '-'} over "
                                    f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
-        ok = None if mean is None else intervals_overlap(ci, th["ci95"])
+        ok = None if mean is None or ci is None else intervals_overlap(ci, th["ci95"])
         er = " (e.r.)" if empirical_range else ""
         label = f"{estimator}-{bound}{'-er' if empirical_range else ''}-delta={delta:g}"
         b.add(RowSpec(id=f"table-5.2/{label}", group="Section 5.1",
@@ -225,8 +225,8 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
                   f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
               slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
-              fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range,
-                      "delta": delta, "theoretical_range": None if theoretical else c.method.error.theoretical_range,
+              fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range, "delta": delta,
+                      "theoretical_range": None if theoretical else method_of(c, Adaptive).error.theoretical_range,
                       "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
     complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
@@ -272,11 +272,11 @@ def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, r
     if authors is not None:
         a_names = [c.name for c in authors.configs]
         got = dict(authors_recs or {})
-        a_med = _median_steps(got, a_names, 1)
+        a_med = _median_steps(got, a_names, 1) or []  # no medians: None and [] alike
         n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
         a_col = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
                          f"median {np.median(a_med):.1e}" if a_med else "-",
-                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))  # type: ignore[union-attr]
+                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))
     b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{exponent}",
           ours=ours,
           difference=diff, ok=ok, rule="order", kind="read off a figure", page=page, heading=heading,
@@ -293,8 +293,8 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             mean, ci = _mean_ci(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
             b.add(RowSpec(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", output=out,
-                  quantity=f"improvement ratio, {label}, N = {c.method.batch_size}", where="Section 5.2.1 (Figure 5.5)",
-                  thesis=pct(th["improvement_ratio"]),
+                  quantity=f"improvement ratio, {label}, N = {method_of(c, Vanilla).batch_size}",
+                  where="Section 5.2.1 (Figure 5.5)", thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
                   ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r),
@@ -353,7 +353,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
             a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
             a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
                              lambda *_, t=text, i=a_pi: in_prediction(t, i), interval=a_pi,
-                             interval_text=pi_text(a_pi, fmt, ar and ar["seeds"]))
+                             interval_text=pi_text(a_pi, fmt, ar["seeds"] if ar else None))
             out = output(c.name, "upsilon_bar") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(pi, fmt)}",
@@ -374,7 +374,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                                                    lambda x: pct(x, 1)),
                              lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
                              interval=ratio_interval(ar), interval_text=ratio_text(ar),
-                             vacuous=frozen(ar and ar.get("theta_moved")))
+                             vacuous=frozen(ar.get("theta_moved") if ar else None))
             out = output(c.name, "improvement_ratio") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/improvement-ratio", group=group,
                   quantity=f"improvement ratio, {method}",
