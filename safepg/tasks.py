@@ -159,5 +159,5 @@ def task_hooks(task: Task) -> Hooks:
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
 
 
-__all__ = ["ActionDimension", "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns", "Performance",
-           "PerformanceBatch", "Task", "task_hooks"]
+__all__ = ["METHOD_HOOKS", "ActionDimension", "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns",
+           "Performance", "PerformanceBatch", "Task", "task_hooks"]

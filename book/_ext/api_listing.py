@@ -3,9 +3,8 @@
 ``book/api.md`` holds one fenced block ``{safepg-api}`` with a module name per line. Before
 the page is parsed, this extension replaces the block with, for each module: a heading, the
 first line of the module's docstring, an autosummary table of the module's public names and
-the full autodoc entry of each. The names are read from the module itself (its ``__all__``,
-else the public names its source defines at top level), so a name added to a module appears
-on the page without editing it, and a module is added with one line.
+the full autodoc entry of each. The names are the module's ``__all__``, so a name added
+there appears on the page without editing it, and a module is added with one line.
 
 An object that an earlier section already documents in full (``safepg.LQG`` is
 ``safepg.envs.LQG``) gets a one-line entry pointing there, which keeps the page short and
@@ -31,11 +30,9 @@ moves such an id onto the table the spec belongs to, which the HTML writes.
 
 from __future__ import annotations
 
-import ast
 import importlib
 import inspect
 import re
-from pathlib import Path
 from typing import Any
 
 from docutils import nodes
@@ -81,7 +78,7 @@ def block_modules(text: str) -> list[str]:
 
 
 def public_names(modname: str) -> list[str]:
-    """The public names of a module: its ``__all__``, else what its source defines.
+    """The public names of a module: its ``__all__``, in its order.
 
     Parameters
     ----------
@@ -91,36 +88,17 @@ def public_names(modname: str) -> list[str]:
     Returns
     -------
     list of str
-        ``__all__`` in its order when the module has one; otherwise the classes, functions
-        and assigned names its source defines at top level, in source order, without those
-        starting with an underscore (imported names are not the module's own).
+        ``__all__`` without what the import did not define (an optional dependency missing).
+
+    Raises
+    ------
+    ValueError
+        The module has no ``__all__``: what it exports must be said there, not guessed.
     """
     module = importlib.import_module(modname)
-    if hasattr(module, "__all__"):
-        return list(module.__all__)
-    tree = ast.parse(Path(inspect.getsourcefile(module)).read_text(encoding="utf-8"))
-    names: list[str] = []
-
-    def scan(body: list[ast.stmt]) -> None:
-        for node in body:
-            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
-                found = [node.name]
-            elif isinstance(node, ast.Assign):
-                found = [t.id for t in node.targets if isinstance(t, ast.Name)]
-            elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
-                found = [node.target.id]
-            elif isinstance(node, ast.If | ast.Try):
-                # Definitions that depend on an optional dependency (``try: import gymnasium``).
-                for part in (node.body, node.orelse, getattr(node, "finalbody", [])):
-                    scan(part)
-                found = []
-            else:
-                found = []
-            names.extend(n for n in found if not n.startswith("_") and n not in names)
-
-    scan(tree.body)
-    # What the import did not define (an optional dependency is missing) is not listed.
-    return [n for n in names if hasattr(module, n)]
+    if not hasattr(module, "__all__"):
+        raise ValueError(f"{modname} must define __all__ to be on the API page")
+    return [n for n in module.__all__ if hasattr(module, n)]
 
 
 def _kind(obj: Any) -> str:
