@@ -9,7 +9,7 @@ import numpy as np
 
 from safepg import portable
 
-#: Values of :attr:`TaskConstants.horizon_term`.
+#: Values of the ``horizon_term`` of :class:`TaskConstants`.
 HORIZON_TERMS = ("effective", "truncated", "horizon")
 
 

@@ -46,7 +46,7 @@ class _Update:
 
 #: (samples (n, m), their mean, n, the batch's measured (R, M_phi) or None) -> the update.
 #: The loop computes the mean once.
-UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"], _Update]
+_UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"], _Update]
 #: ``progress`` of the learning loops: True for a tqdm bar, or a callable ``report(used, budget)``.
 Progress = bool | Callable[[int, int], object]
 
@@ -98,7 +98,7 @@ def _learn(
     task: Task,
     hooks: Hooks,
     policy: LinearGaussianPolicy,
-    rule: UpdateRule,
+    rule: _UpdateRule,
     n_first: int,
     budget: int,
     rng: RNGLike,
@@ -405,5 +405,5 @@ def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0
     raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "adaptive_pg", "guaranteed_improvement", "learn",
-           "vanilla_pg"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "Progress", "RecordFileError", "adaptive_pg", "guaranteed_improvement",
+           "learn", "vanilla_pg"]

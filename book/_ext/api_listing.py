@@ -30,6 +30,7 @@ moves such an id onto the table the spec belongs to, which the HTML writes.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import inspect
 import re
@@ -255,6 +256,21 @@ def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: li
     lines[:] = plain_bars(lines)
 
 
+def _signature(app: Any, what: str, name: str, obj: Any, options: Any, signature: str | None,
+               return_annotation: str | None) -> tuple[str | None, str | None] | None:
+    """A dataclass's signature with each ``<factory>`` default written as the value it makes.
+
+    ``<factory>`` is not Python: Sphinx would then give up parsing the signature and split it
+    at every comma, annotations included (``Literal['scalar', 'coordinate']``).
+    """
+    if not signature or "<factory>" not in signature or not dataclasses.is_dataclass(obj):
+        return None
+    for f in dataclasses.fields(obj):
+        if f.init and f.default_factory is not dataclasses.MISSING:
+            signature = signature.replace("<factory>", repr(f.default_factory()), 1)
+    return signature, return_annotation
+
+
 def _source_read(app: Any, docname: str, source: list[str]) -> None:
     if "{safepg-api}" in source[0]:
         pointers: set[str] = set()
@@ -321,7 +337,8 @@ def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
         name = documented.get(id(_identity(obj)))
         if name is not None:
             py = env.get_domain("py")
-            return py.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], name, node, contnode)
+            # "obj" matches any kind: an annotation's type alias (RNGLike) is documented as data.
+            return py.resolve_xref(env, node["refdoc"], app.builder, "obj", name, node, contnode)
     return None
 
 
@@ -358,6 +375,7 @@ def setup(app: Any) -> dict[str, Any]:
     # Before numpydoc (priority 500) turns the sections into reStructuredText.
     app.connect("autodoc-process-docstring", _docstring, priority=400)
     app.connect("missing-reference", _missing_reference)
+    app.connect("autodoc-process-signature", _signature)
     app.add_transform(KeepTargetIds)
     # Doctrees read before KeepTargetIds existed lack the module ids: a new env_version has
     # Sphinx read every page again instead of reusing them.
