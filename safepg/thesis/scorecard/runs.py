@@ -1,5 +1,5 @@
 """Rows of the stored runs of Chapter 5: Tables 5.1-5.4, Figures 5.5-5.7, the step sizes and the
-cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.experiments.report`).
+cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.report.report`).
 
 Each row holds ours (the thesis's text), ours under the authors' settings where a variant runs
 them (the ``*-authors`` experiments; for Table 5.2's theoretical range, the authors' formula) and
