@@ -64,13 +64,13 @@ def test_no_box_is_table_5_4_and_every_box_is_table_5_4_authors(explorer):
     p0 = explorer.defaults()
     thesis = get_experiment("table-5.4").config("adaptive")
     assert adaptive_method(p0) == thesis.method
-    assert cartpole_task(p0).setting_name() == thesis.env == "cartpole-doubled"
+    assert cartpole_task(p0).setting_name() == thesis.task == "cartpole-doubled"
     authors = get_experiment("table-5.4-authors-theta-star").config("adaptive")
     p1 = {**p0, **{b: True for b in BOXES}}
     method = adaptive_method(p1)
     assert (method.error, method.batches, method.departures) == (
         authors.method.error, authors.method.batches, authors.method.departures)
-    assert cartpole_task(p1).setting_name() == authors.env
+    assert cartpole_task(p1).setting_name() == authors.task
     assert explorer.data["starts"]["theta_star"] == list(authors.theta0) == cartpole_theta_star().tolist()
     van = get_experiment("table-5.4").config("N=4000")
     assert vanilla_method() == van.method  # the fixed-step method is table-5.4's, whatever the boxes

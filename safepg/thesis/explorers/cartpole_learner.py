@@ -30,6 +30,7 @@ from safepg.thesis.explorers.ch5_live import (
     CURVE_POINTS,
     Ch5LiveExplorer,
     Reporter,
+    fixed,
     iteration_series,
     kernel_text,
     record_c,
@@ -144,10 +145,6 @@ def _exp(v: float | None) -> str:
     return f"{mantissa}e{int(exponent):+d}"
 
 
-def _fixed(v: float | None, d: int) -> str:
-    return "-" if v is None else f"{v:.{d}f}"
-
-
 def settings_line(p: Mapping[str, Any]) -> str:
     """The settings a run used, in words (the page's ``safepgCartpoleSettings``)."""
     return ("Settings: " + ("gamma = 1 in the return, 0.9 in c" if p["gamma09"] else "gamma = 0.99")
@@ -187,7 +184,7 @@ def cartpole_result(p: Mapping[str, Any], traces: Mapping[str, Any], data: Mappi
         s["c_min"], s["c_max"] = (min(cs), max(cs)) if cs else (None, None)
         values[name] = s
         head = (f"{label}: {s['iterations']} iterations, {s['trajectories']} trajectories, mean batch return "
-                f"{_fixed(s['upsilon_bar'], 2)}")
+                f"{fixed(s['upsilon_bar'], 2)}")
         if name == "adaptive":
             theta0 = r["theta"][0]
             for j, nm in enumerate(data["theta_names"]):

@@ -48,7 +48,7 @@ from safepg.options import Adaptive, Batches, Departures, FixedStep, Gradient, V
 from safepg.record import on_trajectories
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band
-from safepg.thesis.explorers.ch5_live import bound_control_error
+from safepg.thesis.explorers.ch5_live import bound_control_error, fixed, thin
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
@@ -97,13 +97,6 @@ def task_data(env: LQG | None = None) -> dict[str, Any]:
             "Avol": env.action_volume, "Abar": env.action_bound}
 
 
-def _thin(n: int, points: int = CURVE_POINTS) -> np.ndarray:
-    """Indices of at most ``points`` evenly spread entries of a length-n curve (first and last kept)."""
-    if n <= points:
-        return np.arange(n)
-    return np.unique(np.floor(np.arange(points) * (n - 1) / (points - 1) + 0.5).astype(np.int64))
-
-
 def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> dict[str, Any]:
     """The embedded curves of one stored configuration: seed means up to the largest budget."""
     top = BUDGETS[-1]
@@ -115,7 +108,7 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
     for i, (s, k) in enumerate(zip(starts, cut)):
         start[i, :k] = s[:k]
     start_mean = np.nanmean(start, axis=0)
-    keep = _thin(max(cut))
+    keep = np.asarray(thin(max(cut)))
     per_budget = {}
     for B in BUDGETS:
         ups, its = [], []
@@ -269,11 +262,6 @@ def run_summary(rec: LearningRecord, tol: float) -> dict[str, Any]:
             "first_batches": rec.batch_size[:3].tolist(), "done": True, "diverged": rec.diverged}
 
 
-def _fixed(v: Any, digits: int) -> str:
-    """The page's number format: ``digits`` decimals, "-" for none."""
-    return "-" if v is None or not np.isfinite(v) else f"{v:.{digits}f}"
-
-
 def _moved_text(v: float) -> str:
     """A movement as the page writes it: 0, 7.0e-5 under 10^-3, else 4 decimals."""
     if not np.isfinite(v):
@@ -291,12 +279,12 @@ def run_line(name: str, v: Mapping[str, Any], data: Mapping[str, Any]) -> str:
     moved = _moved_text(v["theta_moved"])
     if v["ratio_vacuous"]:
         ratio = (f"theta moved by {moved}, less than {100 * data['still']:g}% of the way to theta* = "
-                 f"{_fixed(data['theta_star'], 2)}: the improvement ratio carries no information")
+                 f"{fixed(data['theta_star'], 2)}: the improvement ratio carries no information")
     else:
-        ratio = f"theta moved by {moved}, improvement ratio {_fixed(100 * v['improvement_ratio'], 2)}%"
+        ratio = f"theta moved by {moved}, improvement ratio {fixed(100 * v['improvement_ratio'], 2)}%"
     return (f"{name}: {v['iterations']} iterations, {v['trajectories']} trajectories, "
-            f"Upsilon-bar {_fixed(v['upsilon_bar'], 4)}, J {_fixed(v['J_final'], 3)} at theta "
-            f"{_fixed(v['theta_final'], 4)}{' (diverged)' if v['diverged'] else ''}; {ratio}.")
+            f"Upsilon-bar {fixed(v['upsilon_bar'], 4)}, J {fixed(v['J_final'], 3)} at theta "
+            f"{fixed(v['theta_final'], 4)}{' (diverged)' if v['diverged'] else ''}; {ratio}.")
 
 
 def objectives_line(data: Mapping[str, Any]) -> str:
@@ -317,7 +305,7 @@ def summary_text(values: Mapping[str, Any], data: Mapping[str, Any], budget: int
     th = values["thesis"]
     if th["found"]:  # toFixed(0) rounds halves up
         lines.append(f"stored safepg run {th['name']} (seed mean, first {budget} trajectories): "
-                     f"{math.floor(th['iterations'] + 0.5)} iterations, Upsilon-bar {_fixed(th['upsilon_bar'], 4)}.")
+                     f"{math.floor(th['iterations'] + 0.5)} iterations, Upsilon-bar {fixed(th['upsilon_bar'], 4)}.")
     else:
         lines.append("no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, "
                      "delta in {0.05, 0.25, 0.5, 0.75, 0.95}).")
@@ -360,16 +348,16 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         k = next((i for i, s in enumerate(run["start"]) if s is None or s >= budget), len(run["start"]))
         g = int(np.searchsorted(data["grid"], budget, side="right"))
         seeds = f"{run['seeds']} seed{'' if run['seeds'] == 1 else 's'}"
-        thin = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({seeds})"}
-        plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **thin})
-        plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **thin})
-        plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **thin})
+        muted = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({seeds})"}
+        plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **muted})
+        plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **muted})
+        plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **muted})
         values["thesis"] = {"found": True, "key": key, "name": run["name"], **run["budgets"][str(budget)]}
     else:
         values["thesis"] = {"found": False, "key": key}
     values["vanilla"] = None
     for name, rec in recs.items():
-        keep = _thin(rec.iterations, data["points"])
+        keep = np.asarray(thin(rec.iterations, data["points"]))
         style = ({"color": data["colors"][bound], "dash": p["estimator"] == "reinforce"} if name == "adaptive"
                  else {"color": data["vanilla_color"], "dash": False})
         style["label"] = ("Algorithm 4.1 (safepg)" if name == "adaptive"
