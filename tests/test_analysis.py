@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
+from safepg.definition import to_dict
 from safepg.learning import LearningRecord
+from safepg.options import Adaptive, ErrorModel, FixedStep, Vanilla
 from safepg.record import on_trajectories
 from safepg.thesis.analysis import (
     by_iteration,
@@ -37,10 +39,11 @@ def test_by_iteration_and_band():
 
 
 def test_table_5_2_differences():
-    report = {"configs": [{"estimator": "gpomdp", "bound": "bernstein", "empirical_range": True, "delta": 0.95,
-                           "seeds": 5, "upsilon_bar": {"mean": -9.7, "ci95": [-9.8, -9.6]},
+    method = to_dict(Adaptive(error=ErrorModel("bernstein", 0.95, "empirical")))
+    report = {"configs": [{"method": method, "seeds": 5, "upsilon_bar": {"mean": -9.7, "ci95": [-9.8, -9.6]},
                            "improvement_ratio": {"mean": 1.0}, "thesis": {"upsilon_bar": -9.6623, "ci95": [1, 2]}}]}
     row = table_5_2(report)[0]
+    assert (row["estimator"], row["bound"], row["empirical_range"], row["delta"]) == ("gpomdp", "bernstein", True, 0.95)
     assert abs(row["difference"] - (-9.7 + 9.6623)) < 1e-12
     md = markdown_table([row], [("ours", "ours", ".3f"), ("ci95", "CI", ".1f"), ("missing", "x", "")])
     assert md.splitlines()[2] == "| -9.700 | [-9.8; -9.6] | - |"
@@ -96,17 +99,18 @@ def test_on_trajectories_holds_each_batch_average():
 
 def test_table_upsilon_differences():
     report = {"configs": [
-        {"name": "adaptive", "batch_size": None, "alpha": None, "seeds": 5,
+        {"name": "adaptive", "method": to_dict(Adaptive()), "seeds": 5,
          "upsilon_bar": {"mean": 184.2, "ci95": [183.0, 185.4]},
          "improvement_ratio": {"mean": 0.55, "ci95": [0.5, 0.6]},
          "thesis": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301}},
-        {"name": "extra", "batch_size": 10, "alpha": 0.1, "seeds": 1,
+        {"name": "extra", "method": to_dict(Vanilla(10, FixedStep(0.1))), "seeds": 1,
          "upsilon_bar": {"mean": 1.0, "ci95": [1.0, 1.0]}, "improvement_ratio": {"mean": 1.0, "ci95": [1, 1]},
          "thesis": None}]}
     a, extra = table_upsilon(report)
     assert a["upsilon_difference"] == pytest.approx(184.2 - 193.12)
     assert a["improvement_difference"] == pytest.approx(0.55 - 0.5301)
     assert a["batch_size"] is None and extra["thesis_upsilon_bar"] is None and extra["upsilon_difference"] is None
+    assert (extra["batch_size"], extra["alpha"]) == (10, 0.1)
 
 
 def test_comparison_figures_draw_the_seed_means():

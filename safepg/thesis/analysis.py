@@ -35,12 +35,23 @@ def compare(ours: float | None, thesis: float | None) -> dict[str, Any]:
     return {"ours": ours, "thesis": thesis, "difference": diff}
 
 
+def method_columns(method: dict[str, Any]) -> dict[str, Any]:
+    """The thesis's table columns of a method written as data (:func:`safepg.definition.to_dict`):
+    ``estimator``, ``bound``, ``empirical_range`` (its "e.r."), ``delta``, and the fixed
+    ``batch_size`` and ``alpha`` (None for Algorithm 4.1 or a safe step)."""
+    step = method.get("step") or {}
+    error = method.get("error") or step.get("error") or {}
+    return {"estimator": method["gradient"]["estimator"], "bound": error.get("bound"),
+            "empirical_range": error.get("range") == "empirical", "delta": error.get("delta"),
+            "batch_size": method.get("batch_size"), "alpha": step.get("alpha")}
+
+
 def table_5_1(report: dict[str, Any]) -> list[dict[str, Any]]:
     """Rows of Table 5.1: improvement ratio by sigma, N, alpha, ours beside the thesis's."""
     rows = []
     for c in report["configs"]:
-        ir = c["improvement_ratio"]
-        rows.append({"sigma": c["sigma"], "N": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+        ir, m = c["improvement_ratio"], method_columns(c["method"])
+        rows.append({"sigma": c["sigma"], "N": m["batch_size"], "alpha": m["alpha"], "seeds": c["seeds"],
                      "diverged": c.get("diverged", 0),
                      "ci95": ir["ci95"], **compare(ir["mean"], (c["thesis"] or {}).get("improvement_ratio"))})
     return rows
@@ -50,9 +61,9 @@ def table_5_2(report: dict[str, Any]) -> list[dict[str, Any]]:
     """Rows of Table 5.2: average performance with 95% CI, ours beside the thesis's."""
     rows = []
     for c in report["configs"]:
-        ub, th = c["upsilon_bar"], c["thesis"] or {}
-        rows.append({"estimator": c["estimator"], "bound": c["bound"], "empirical_range": c["empirical_range"],
-                     "delta": c["delta"], "seeds": c["seeds"], "ci95": ub["ci95"], "thesis_ci95": th.get("ci95"),
+        ub, th, m = c["upsilon_bar"], c["thesis"] or {}, method_columns(c["method"])
+        rows.append({"estimator": m["estimator"], "bound": m["bound"], "empirical_range": m["empirical_range"],
+                     "delta": m["delta"], "seeds": c["seeds"], "ci95": ub["ci95"], "thesis_ci95": th.get("ci95"),
                      "improvement_ratio": c["improvement_ratio"]["mean"],
                      **compare(ub["mean"], th.get("upsilon_bar"))})
     return rows
@@ -64,9 +75,10 @@ def table_upsilon(report: dict[str, Any]) -> list[dict[str, Any]]:
     rows = []
     for c in report["configs"]:
         ub, ir, th = c["upsilon_bar"], c["improvement_ratio"], c["thesis"] or {}
+        m = method_columns(c["method"])
         up = compare(ub["mean"], th.get("upsilon_bar"))
         imp = compare(ir["mean"], th.get("improvement_ratio"))
-        rows.append({"name": c["name"], "batch_size": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+        rows.append({"name": c["name"], "batch_size": m["batch_size"], "alpha": m["alpha"], "seeds": c["seeds"],
                      "upsilon_bar": up["ours"], "upsilon_ci95": ub["ci95"], "thesis_upsilon_bar": up["thesis"],
                      "upsilon_difference": up["difference"],
                      "improvement_ratio": imp["ours"], "improvement_ci95": ir["ci95"],
