@@ -105,8 +105,8 @@ def test_figures_5_1_5_2_overlay_carry_ours_and_the_authors_curves(figure):
         assert len(colours) == len(theirs) == len(configs)
         by_estimator = sorted(configs, key=lambda c: c.method.gradient.estimator != "gpomdp")
         for c, ours_line, their_line in zip(by_estimator, colours, theirs):
-            f = c.fields()
-            curve = authors.figure51_52_curves()[(f["estimator"], f["bound"], f["empirical_range"], f["delta"])]
+            e = c.method.error
+            curve = authors.figure51_52_curves()[(c.method.gradient.estimator, e.bound, e.empirical_range, e.delta)]
             assert np.array_equal(their_line.get_ydata(), curve["J"])
             grid = curve["trajectories"].astype(np.int64)
             assert np.array_equal(ours_line.get_xdata(), grid)
