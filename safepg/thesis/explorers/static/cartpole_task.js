@@ -12,7 +12,7 @@
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
   /** safepg's CartPole() field by field (camelCase); polemassLength and constantsGamma null as there. */
   const CARTPOLE_DEFAULT = Object.freeze({
     kind: "cartpole", poleLength: 1.0, gamma: 0.99, H: 200, angleThresholdDeg: 41.8, xThreshold: 2.4,

@@ -498,7 +498,7 @@ const safepgLearner = (function () {
     });
   };
 
-  return {Rng, pairwiseSum, sampleVariance, range, lqgPerformance, reinforceVarianceFactor, gpomdpVarianceFactor,
+  return {check, Rng, pairwiseSum, sampleVariance, range, lqgPerformance, reinforceVarianceFactor, gpomdpVarianceFactor,
           gradientRangeBound, penaltyConstant, chebyshev, hoeffding, bernstein, eps, errorBound, coordinateStep,
           nZero, upsilon, nStarClosedForm, nStarSearch, optimalBatchSize, adaptiveUpdate, Workspace,
           gradientSamples, rngDraw, Run, Driver, summary, THESIS_1D, DEFAULTS, N_STAR_FACTOR,

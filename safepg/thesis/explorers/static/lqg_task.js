@@ -10,7 +10,7 @@
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
   function asMatrix(x, m, name) {
     if (typeof x === "number") {
       const out = new Float64Array(m * m);

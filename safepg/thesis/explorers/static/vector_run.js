@@ -9,7 +9,7 @@
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
   const VECTOR_DEFAULTS = Object.freeze({
     algorithm: "adaptive", theta0: 0, sigma: 1, estimator: "gpomdp", baseline: true, bound: "chebyshev",
     delta: 0.95, empiricalRange: false, theoreticalRange: null, nMin: 100, nMax: 500000, nFirst: null,
