@@ -200,10 +200,15 @@ const safepgLearner = (function () {
     return x * x * bracket;
   }
   function gradientRangeBound(k) { return 2 * k.H * k.M * k.Abar * k.R / (k.sigma * k.sigma * (1 - k.gamma)); }
+  /** safepg.meta.penalty_constant, the horizon factor h of TaskConstants.horizon_term included. */
   function penaltyConstant(k) {
     const g = k.gamma, s = k.sigma;
-    return k.R * (k.M * k.M) / (((1 - g) * (1 - g)) * (s * s)) *
-      (k.Avol / (Math.sqrt(2 * Math.PI) * s) + g / (2 * (1 - g)));
+    if (!k.horizonTerm || k.horizonTerm === "effective") {
+      return k.R * (k.M * k.M) / (((1 - g) * (1 - g)) * (s * s)) *
+        (k.Avol / (Math.sqrt(2 * Math.PI) * s) + g / (2 * (1 - g)));
+    }
+    const h = k.horizonTerm === "horizon" || g === 1 ? k.H : (1 - Math.pow(g, k.H)) / (1 - g);
+    return k.R * (k.M * k.M) * (h * h) / (s * s) * (k.Avol / (Math.sqrt(2 * Math.PI) * s) + g * h / 2);
   }
   function chebyshev(delta, variance) { return {d: Math.sqrt(variance / delta), f: 0}; }
   function hoeffding(delta, gradRange) { return {d: gradRange * Math.sqrt(Math.log(2 / delta) / 2), f: 0}; }
@@ -214,24 +219,26 @@ const safepgLearner = (function () {
   function eps(bd, n) { return bd.d / Math.sqrt(n) + bd.f / n; }
   /**
    * safepg.bounds.error_bound for one component's samples x[0..n).
-   * cfg: {bound, delta, estimator, empiricalRange, theoreticalRange}; k: task constants.
+   * cfg: {bound, delta, estimator, empiricalRange, theoreticalRange}; k: task constants;
+   * spread: {variance, range} in place of the samples' own (the maxima over components), or null.
    */
-  function errorBound(cfg, x, n, k, scratch) {
+  function errorBound(cfg, x, n, k, scratch, spread = null) {
     if (cfg.bound === "chebyshev")
       return chebyshev(cfg.delta, cfg.estimator === "reinforce" ? reinforceVarianceFactor(k) : gpomdpVarianceFactor(k));
-    const R = cfg.empiricalRange ? range(x, n)
+    const R = cfg.empiricalRange ? (spread ? spread.range : range(x, n))
       : (cfg.theoreticalRange != null ? cfg.theoreticalRange : gradientRangeBound(k));
     if (cfg.bound === "hoeffding") return hoeffding(cfg.delta, R);
-    if (cfg.bound === "bernstein") return bernstein(cfg.delta, sampleVariance(x, n, scratch), R);
+    if (cfg.bound === "bernstein") return bernstein(cfg.delta, spread ? spread.variance : sampleVariance(x, n, scratch), R);
     throw new RangeError(`bound must be chebyshev, hoeffding or bernstein, got ${cfg.bound}`);
   }
 
   // -------------------------------------------------------------- meta-parameters
   const N_STAR_FACTOR = (13 + 3 * Math.sqrt(17)) / 2;
-  /** Corollary 4.2.8: 0 when eps >= g (no guarantee, no move). */
-  function coordinateStep(g, e, c) {
-    if (e >= g) return 0;
-    return (g - e) * (g - e) / (2 * c * ((g + e) * (g + e)));
+  /** Corollary 4.2.8: 0 when eps >= g (no guarantee, no move), unless unguarded (the authors' step). */
+  function coordinateStep(g, e, c, guarded = true) {
+    if (e >= g && guarded) return 0;
+    const lo = g - e, hi = g + e;
+    return hi === 0 ? 0 : lo * lo / (2 * c * (hi * hi));
   }
   function nZero(g, bd) {
     if (g === 0) return Infinity;

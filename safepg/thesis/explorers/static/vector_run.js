@@ -27,44 +27,17 @@
     return {R: task.rewardBound, M: task.featureBound, Avol: task.actionVolume, Abar: task.actionBound,
             gamma: task.gamma, H: task.H, sigma: sigma, horizonTerm: "effective"};
   }
-  /** safepg.meta.penalty_constant, the horizon factor h of TaskConstants.horizon_term included. */
-  function penaltyConstantH(k) {
-    if (!k.horizonTerm || k.horizonTerm === "effective") return L.penaltyConstant(k);
-    const g = k.gamma, s = k.sigma;
-    const h = k.horizonTerm === "horizon" || g === 1 ? k.H : (1 - Math.pow(g, k.H)) / (1 - g);
-    return k.R * (k.M * k.M) * (h * h) / (s * s) * (k.Avol / (Math.sqrt(2 * Math.PI) * s) + g * h / 2);
-  }
   /** safepg.meta.scalar_step: the step of [24], ||(|g| - eps)+||_2^2 / (2 c ||(|g| + eps)||_1^2). */
   function scalarStep(grad, e, c) {
     let lo2 = 0, up = 0;
     for (const v of grad) { const a = Math.abs(v), lo = Math.max(a - e, 0); lo2 += lo * lo; up += a + e; }
     return up === 0 ? 0 : lo2 / (2 * c * (up * up));
   }
-  /** safepg.meta.coordinate_step, guarded (0 when eps >= g) unless stepWhenUnsafe. */
-  function coordinateStepU(g, e, c, guarded) {
-    if (e >= g && guarded) return 0;
-    const lo = g - e, hi = g + e;
-    return hi === 0 ? 0 : lo * lo / (2 * c * (hi * hi));
-  }
   /** Sample variance (ddof = 1) and range of row p of an (m, n) component-major array. */
   function rowStats(x, p, n, scratch) {
     const row = x.subarray(p * n, p * n + n);
     return {variance: L.sampleVariance(row, n, scratch), range: L.range(row, n)};
   }
-  /**
-   * safepg.bounds.error_bound on component p with the overrides of statistics="max"
-   * (spread: {variance, range} or null).
-   */
-  function errorBoundN(cfg, x, p, n, k, scratch, spread, theoreticalRange) {
-    const row = x.subarray(p * n, p * n + n);
-    if (cfg.bound === "chebyshev")
-      return L.chebyshev(cfg.delta, cfg.estimator === "reinforce" ? L.reinforceVarianceFactor(k) : L.gpomdpVarianceFactor(k));
-    const R = cfg.empiricalRange ? (spread ? spread.range : L.range(row, n))
-      : (theoreticalRange != null ? theoreticalRange : L.gradientRangeBound(k));
-    if (cfg.bound === "hoeffding") return L.hoeffding(cfg.delta, R);
-    return L.bernstein(cfg.delta, spread ? spread.variance : L.sampleVariance(row, n, scratch), R);
-  }
-
   /** The random numbers of a run from its own generator (learner.js's Rng). */
   function rngSource(rng) {
     return {
@@ -141,7 +114,7 @@
     this.cfg = cfg; this.task = task; this.m = m;
     this.batch = task.kind === "lqg" ? new L.LqgBatch(task) : new L.CartpoleBatch(task);
     this.k = taskConstants(task, cfg.sigma);
-    this.c = penaltyConstantH(this.k);
+    this.c = L.penaltyConstant(this.k);
     this.src = src || rngSource(new L.Rng(cfg.seed, cfg.stream));
     const th = Array.isArray(cfg.theta0) || ArrayBuffer.isView(cfg.theta0) ? cfg.theta0 : null;
     this.theta = Float64Array.from({length: m}, (_, i) => (th ? th[i] : cfg.theta0));
@@ -201,7 +174,7 @@
     let kc = this.k, c = this.c;
     if (cfg.constants === "batch") {
       kc = Object.assign({}, this.k, {R: found[0], M: found[1]});
-      c = penaltyConstantH(kc);
+      c = L.penaltyConstant(kc);
     }
     let spread = null;
     if (cfg.statistics === "max") {
@@ -212,9 +185,9 @@
         spread.range = Math.max(spread.range, st.range);
       }
     }
-    const bd = errorBoundN(cfg, x, k, n, kc, this.batch.scratch, spread, cfg.theoreticalRange);
+    const bd = L.errorBound(cfg, x.subarray(k * n, k * n + n), n, kc, this.batch.scratch, spread);
     const e = L.eps(bd, n);
-    const alpha = coordinateStepU(g, e, c, !cfg.stepWhenUnsafe);
+    const alpha = L.coordinateStep(g, e, c, !cfg.stepWhenUnsafe);
     const step = new Float64Array(m);
     step[k] = alpha * grad[k];
     return {step, alpha, k, eps: e, safe: e < g, c, d: bd.d, f: bd.f,
@@ -226,9 +199,9 @@
     let e = 0, safe = true, a = cfg.alpha;
     if (a === null) {
       e = -Infinity;  // one eps for every component: the largest per-component bound
-      for (let p = 0; p < m; p++) e = Math.max(e, L.eps(errorBoundN(cfg, x, p, n, this.k, this.batch.scratch, null, null), n));
+      for (let p = 0; p < m; p++) e = Math.max(e, L.eps(L.errorBound(cfg, x.subarray(p * n, p * n + n), n, this.k, this.batch.scratch), n));
       safe = e < Math.abs(grad[k]);
-      a = cfg.step === "scalar" ? scalarStep(grad, e, this.c) : coordinateStepU(Math.abs(grad[k]), e, this.c, true);
+      a = cfg.step === "scalar" ? scalarStep(grad, e, this.c) : L.coordinateStep(Math.abs(grad[k]), e, this.c, true);
     }
     const step = new Float64Array(m);
     if (cfg.step === "scalar") for (let p = 0; p < m; p++) step[p] = a * grad[p];
@@ -260,6 +233,6 @@
   }
   L.Driver.makeRun = makeRun;
 
-  Object.assign(L, {VECTOR_DEFAULTS, VectorRun, makeRun, taskConstants, penaltyConstantH, scalarStep,
-                    coordinateStepU, errorBoundN, rngSource, arraySource, oneDTask});
+  Object.assign(L, {VECTOR_DEFAULTS, VectorRun, makeRun, taskConstants, scalarStep, rngSource, arraySource,
+                    oneDTask});
 })(safepgLearner);
