@@ -277,8 +277,8 @@ def test_without_ensurepip_elsewhere_says_what_to_install(tmp_path):
 
 def test_nbval_kernel_beside_other_workers_runs_numba_on_one_thread(request: pytest.FixtureRequest) -> None:
     """Under pytest-xdist, nbval's kernel is ``python3`` with numba on one thread (conftest.py)."""
-    if not hasattr(request.config, "workerinput"):
-        pytest.skip("only under pytest-xdist: alone, the notebooks keep every core")
+    if not hasattr(request.config, "workerinput") or not request.config.option.nbval:
+        pytest.skip("only under pytest-xdist with nbval: alone, the notebooks keep every core")
     from jupyter_client.kernelspec import KernelSpecManager
     from jupyter_client.manager import start_new_kernel
 
