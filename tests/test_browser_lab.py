@@ -257,17 +257,20 @@ def kernel_state(page: Any) -> str | None:
     from playwright.sync_api import Error, TimeoutError
 
     deadline = time.monotonic() + KERNEL_MS / 1000
+
+    def left_ms() -> float:
+        return max(1.0, (deadline - time.monotonic()) * 1000)
+
     while True:
         try:
-            left_ms = max(1.0, (deadline - time.monotonic()) * 1000)
-            return page.wait_for_function(KERNEL_STATE, timeout=left_ms).json_value()
+            return page.wait_for_function(KERNEL_STATE, timeout=left_ms()).json_value()
         except TimeoutError:
             return None
         except Error:
             # JupyterLab navigates once it has read ?token= from the URL, destroying the context the wait
             # ran in: wait again in the new document once it has loaded.
             try:
-                page.wait_for_load_state("domcontentloaded", timeout=max(1.0, (deadline - time.monotonic()) * 1000))
+                page.wait_for_load_state("domcontentloaded", timeout=left_ms())
             except TimeoutError:
                 return None
 
