@@ -9,8 +9,9 @@ environment's (another clone's) ``safepg`` and test that instead of this one.
 Under pytest-xdist the workers already share the cores, so each worker's notebooks run on a
 copy of that kernel whose numba starts on one thread (``NUMBA_NUM_THREADS=1`` in the copy's
 ``env``), as ``book/tools/execute_pages.py`` runs them for the book: beside the other worker,
-the cart-pole chapter's longest cell took 54 s with two threads and 28 s alone. The copy has
-its own name, so ``python3`` itself, which JupyterLab and the setup tests use, is untouched.
+the cart-pole chapter's longest cell took 28 to 54 s in CI with two threads, under 10 s with
+one. The copy has its own name, so ``python3`` itself, which JupyterLab and the setup tests
+use, is untouched.
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ class OfflinePage:
 
     def set_theme(self, theme: str) -> None:
         """Switch pydata-sphinx-theme's colour mode (``"light"`` or ``"dark"``) as its toggle does."""
-        self.page.evaluate("t => { const d = document.documentElement.dataset; d.theme = t; d.mode = t; }", theme)
+        self.page.evaluate(SET_THEME_JS, theme)
 
     def audit(self) -> dict[str, Any]:
         """Page-wide layout facts (see :data:`AUDIT_JS`): what sticks out of the main column,
@@ -48,6 +48,18 @@ class OfflinePage:
     def values(self, index: int = 0) -> dict:
         """The JSON an explorer writes after each redraw (its ``.safepg-values`` element)."""
         return json.loads(self.page.locator(".safepg-values").nth(index).text_content())
+
+
+#: Switch the colour mode, then wait until the colour transitions it started have ended (the
+#: theme fades colours in about 0.2 s; a contrast check in that fade reads a colour in between).
+SET_THEME_JS = """async t => {
+  const d = document.documentElement.dataset;
+  d.theme = t;
+  d.mode = t;
+  getComputedStyle(document.body).color;  // apply the new colours now, so their transitions exist
+  const fades = document.getAnimations().filter(a => a instanceof CSSTransition);
+  await Promise.all(fades.map(a => a.finished.catch(() => null)));  // a cancelled fade rejects
+}"""
 
 
 #: Layout audit of a book page, run in the browser. Returns

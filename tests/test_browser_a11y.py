@@ -108,7 +108,6 @@ def test_every_page_passes_axe(browser, book, axe_js):
         pg.page.wait_for_function("() => document.readyState === 'complete'")
         for theme in ("light", "dark"):
             pg.set_theme(theme)
-            pg.page.wait_for_timeout(200)  # let the theme's colour transition settle before contrast checks
             assert pg.page.evaluate("() => document.documentElement.dataset.theme") == theme
             problems += report(f"{name} [{theme}]", serious_violations(pg, axe_js))
         assert not pg.errors, (name, pg.errors)

@@ -292,7 +292,7 @@ def test_every_page_reads_well(browser, book):
             pg = OfflinePage(browser, path, width=width, height=900)
             pg.typeset()
             pg.page.wait_for_function("() => document.readyState === 'complete'")
-            pg.page.wait_for_timeout(400)  # the scroll-cue script runs once MathJax is done
+            pg.page.wait_for_function("() => document.documentElement.dataset.safepgCues === 'marked'")
             for theme in ("light", "dark"):
                 pg.set_theme(theme)
                 a = pg.audit()

@@ -257,17 +257,20 @@ def kernel_state(page: Any) -> str | None:
     from playwright.sync_api import Error, TimeoutError
 
     deadline = time.monotonic() + KERNEL_MS / 1000
+
+    def left_ms() -> float:
+        return max(1.0, (deadline - time.monotonic()) * 1000)
+
     while True:
         try:
-            left_ms = max(1.0, (deadline - time.monotonic()) * 1000)
-            return page.wait_for_function(KERNEL_STATE, timeout=left_ms).json_value()
+            return page.wait_for_function(KERNEL_STATE, timeout=left_ms()).json_value()
         except TimeoutError:
             return None
         except Error:
             # JupyterLab navigates once it has read ?token= from the URL, destroying the context the wait
             # ran in: wait again in the new document once it has loaded.
             try:
-                page.wait_for_load_state("domcontentloaded", timeout=max(1.0, (deadline - time.monotonic()) * 1000))
+                page.wait_for_load_state("domcontentloaded", timeout=left_ms())
             except TimeoutError:
                 return None
 
@@ -408,8 +411,18 @@ def test_a_save_in_jupyterlab_changes_the_copy_never_book(browser, lab_on_copy):
         assert MARK not in (ROOT / "book" / CHAPTER).read_text()
         if not before[0]:
             assert _book_state()[0] == "", "git status --porcelain book/ is not empty"
-        # No news popup (lab.sh's overrides: this server has no user settings of the test's).
-        page.wait_for_timeout(3000)
+        # No news popup: the server's settings for it are lab.sh's overrides (this server has no
+        # user settings of the test's). Asking the server is a fact; watching for a popup that
+        # may come later would be a guessed wait.
+        url = f"{info['url']}lab/api/settings/@jupyterlab/apputils-extension:notification?token={info['token']}"
+        with urllib.request.urlopen(url, timeout=30) as r:
+            plugin = json.load(r)
+        # What JupyterLab uses: the user's settings over the schema's defaults, which the
+        # overrides replace.
+        notification = {k: v.get("default") for k, v in plugin["schema"]["properties"].items()}
+        notification.update(plugin["settings"])
+        assert notification.get("fetchNews") == "false", notification
+        assert notification.get("checkForUpdates") is False, notification
         assert page.get_by_text("Jupyter news").count() == 0, "JupyterLab asked about Jupyter news"
         SHOTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(SHOTS / "lab-copy-saved.png"))

@@ -97,8 +97,11 @@
   window.addEventListener("load", () => {
     nameControls();  // again: Font Awesome replaces its <i> icons by SVGs after DOMContentLoaded
     liftCaptions();
-    mark();
-    if (window.MathJax && MathJax.startup && MathJax.startup.promise) MathJax.startup.promise.then(mark);
+    // Once the cues stand as a reader will see them (after MathJax when the page has maths), say so
+    // on <html>: a test of the cues waits for that, not for a guessed delay.
+    const marked = () => { mark(); document.documentElement.dataset.safepgCues = "marked"; };
+    if (window.MathJax && MathJax.startup && MathJax.startup.promise) { mark(); MathJax.startup.promise.then(marked); }
+    else marked();
   });
   window.addEventListener("resize", later);
   document.addEventListener("DOMContentLoaded", later);
