@@ -39,7 +39,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
-from safepg.thesis.explorers.js_tasks import learner_options
+from safepg.thesis.explorers.option_names import learner_options
 
 #: Trajectories per run offered; small, so that a run takes seconds in a browser.
 BUDGETS = (10_000, 20_000, 50_000, 100_000, 200_000)
@@ -250,7 +250,7 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
             # Each box's options under the page learner's names, as far as they differ from the text's.
             "settings": {name: {k: v for k, v in learner_options(change(text)).items() if text_options[k] != v}
                          for name, _, _, change in SETTINGS},
-            "vanilla": {k: van[k] for k in ("batchSize", "alpha", "step")},
+            "adaptive": text_options, "vanilla": van,
             "vanilla_label": f"fixed step (N = {van['batchSize']}, alpha = {van['alpha']:g})"}
 
     def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:

@@ -87,14 +87,13 @@ def _round(values: Any, digits: int = DIGITS) -> list[float | None]:
 
 
 def task_data(env: LQG | None = None) -> dict[str, Any]:
-    """The 1-D LQG settings and bound constants the JavaScript learner runs with."""
+    """The 1-D LQG the page's learner runs (:func:`~safepg.thesis.explorers.js_tasks.lqg_task_data`)."""
+    from safepg.thesis.explorers.js_tasks import lqg_task_data
+
     env = LQG.thesis_1d() if env is None else env
     if env.dim != 1:
         raise ValueError(f"env must be a one-dimensional LQG, got dim={env.dim}")
-    A, B, Q, R = (float(np.asarray(getattr(env, k), dtype=float).reshape(-1)[0]) for k in "ABQR")
-    return {"gamma": env.gamma, "H": env.horizon, "bs": env.state_bound, "ba": env.action_bound, "clip": env.clip,
-            "A": A, "B": B, "Q": Q, "Rc": R, "R": env.reward_bound, "M": env.feature_bound,
-            "Avol": env.action_volume, "Abar": env.action_bound}
+    return lqg_task_data(env)
 
 
 def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> dict[str, Any]:

@@ -42,7 +42,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
-from safepg.thesis.explorers.js_tasks import learner_options
+from safepg.thesis.explorers.option_names import learner_options
 
 #: Budgets offered (trajectories per run); the experiments ran 3*10^7.
 BUDGETS = (30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
@@ -235,7 +235,7 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     data = {"task": _task_or_none(env), "theta0": list(cfg.theta0), "points": CURVE_POINTS,
             "runs": [["adaptive", ADAPTIVE_COLOR], *[[n, c] for n, _, c in FIXED_RUNS]],
             "authors": {k: v for k, v in learner_options(authors_2d()).items()
-                        if k in ("statistics", "stepWhenUnsafe", "nFirst", "nMax")},
+                        if k in ("maxima", "unguardedStep", "first")},
             "printed": (f"Table 5.3 prints after 3*10^7 trajectories: Upsilon-bar {t['adaptive']['upsilon_bar']} "
                         f"(adaptive), {t['N=1000']['upsilon_bar']} (N = 1000), {t['N=100']['upsilon_bar']} "
                         "(N = 100).")}

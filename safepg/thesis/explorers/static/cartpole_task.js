@@ -93,7 +93,7 @@
     const half = ph.half, ml = ph.ml, total = ph.total, pm = ph.poleMass, grav = ph.gravity, tau = ph.tau;
     const semi = ph.semi, ab = task.actionBound, xt = task.xThreshold;
     const at = task.angleThresholdDeg * Math.PI / 180;  // math.radians
-    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.scoreAction !== "raw";
     const gb = baseline && !reinforce, w = reinforce ? 0.0 : 1.0;
     this.grow(n);
     const cap = this.cap, S = this.S, z = this.z, idx = this.idx, disc = this.disc, b = this.b;
