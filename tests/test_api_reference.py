@@ -21,6 +21,7 @@ from types import ModuleType
 
 import pytest
 import yaml
+from script_module import load
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "book" / "api.md"
@@ -30,10 +31,7 @@ REQUIRED = ["safepg", "safepg.options", "safepg.tasks", "safepg.envs", "safepg.d
 
 
 def _listing() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("api_listing", ROOT / "book" / "_ext" / "api_listing.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load("book/_ext/api_listing.py")
 
 
 listing = _listing()

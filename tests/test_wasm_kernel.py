@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from script_module import load
 
 from safepg.envs.lqg import LQG
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
@@ -142,12 +143,7 @@ def test_the_shortcut_past_math_exp_answers_as_math_exp() -> None:
 
 def test_the_committed_binary_is_what_the_source_compiles_to(tmp_path: Path) -> None:
     pytest.importorskip("ziglang", reason="the kernel's compiler (requirements-dev.txt) is not installed")
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("build_wasm", ROOT / "tools" / "build_wasm.py")
-    assert spec and spec.loader
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
+    build = load("tools/build_wasm.py")
     out = tmp_path / "kernel.wasm"
     build.compile_kernel(out)
     assert out.read_bytes() == build.BINARY.read_bytes(), "run `make wasm` and commit the binary"
