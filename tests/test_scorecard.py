@@ -511,3 +511,14 @@ def test_every_authors_curve_is_a_figure_row(rows):
         if r.judged_on == "ours":  # the 90% rule, applied to the share the row shows
             assert (r.status == "reproduced") == (r.ours_value >= sc.CURVE_SHARE), r.id
         assert "prediction band" in r.judged_interval_text or r.judged_on == "", r.id
+
+
+def test_the_tail_cell_is_judged_on_its_larger_sample(rows):
+    """Table 5.1's cell that table-5.1-authors-tail runs again under the authors' settings with more
+    seeds: its authors' column is judged on those runs, every other cell's on table-5.1-authors."""
+    tail = get_experiment("table-5.1-authors-tail").single_config()
+    cell = f"table-5.1/sigma={tail.sigma:g}/N={tail.method.batch_size}/alpha={tail.method.step.alpha:.0e}"
+    t51 = [r for r in rows if r.id.startswith("table-5.1/")]
+    assert len(t51) == 24 and cell in {r.id for r in t51}
+    for r in t51:
+        assert r.authors_experiment == ("table-5.1-authors-tail" if r.id == cell else "table-5.1-authors"), r.id

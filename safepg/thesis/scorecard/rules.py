@@ -137,7 +137,9 @@ STATUS_RULE = ("A row is judged first on \"ours\": our runs as the thesis's text
                "there. Otherwise, when the row has \"ours, authors' settings\" (our runs with what the authors' code "
                "ran where the text says something else or nothing: their starting point, discount, constants, "
                "counting or task), the same rule is applied to that column, and the row is \"" + AUTHORS_STATUS +
-               "\" when it holds there; the row names the setting that did it. Where the authors' column holds only "
+               "\" when it holds there; the row names the setting that did it. Where a cell was run again under "
+               "the authors' settings with more seeds (Table 5.1's σ = 1, N = 1000, α = 1e-4: 50), that column "
+               "is judged on the larger sample. Where the authors' column holds only "
                "through an error of their code (their 2-D J, 16 times the expectation), the row is \"" +
                AUTHORS_ERROR_STATUS + "\". A rule that holds on a run that could not have done otherwise (an "
                "improvement ratio of a run whose θ moves by less than " + f"{FROZEN_THETA:g}" + " in every "
