@@ -16,7 +16,8 @@ from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis.analysis import one_cell_spread
 from safepg.thesis.experiments import Experiment, method_of
-from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction, intervals_overlap
+from safepg.thesis.scorecard import outputs
+from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction, intervals_overlap, is_slip
 from safepg.thesis.scorecard.text import pct
 
 
@@ -125,3 +126,12 @@ def tail_placement(tail: Experiment | None, recs: Mapping[str, Sequence[Learning
                            at_least=s["at_least"], z=s["z"], theta_star=theta_star,
                            crossing_theirs=s["crossing_theirs"],
                            crossing_ours=f"{c.min()} to {c.max()} (mean {c.mean():.0f})")}
+
+
+def slip_sentence(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
+    """The sentence naming a slip between the authors' output and the print ("" when none).
+    ``printed`` as printed (a percentage for a ratio: ``scale`` 100 brings the output there)."""
+    if out.value is None or not out.complete or not is_slip(scale * out.value, printed):
+        return ""
+    return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
+            f"({out.source}), the thesis prints {show(float(printed))}.")

@@ -29,6 +29,7 @@ from safepg.thesis.scorecard.judged import (
     prediction,
     ratio_interval,
     ratio_text,
+    slip_sentence,
     tail_placement,
 )
 from safepg.thesis.scorecard.rules import (
@@ -46,7 +47,6 @@ from safepg.thesis.scorecard.rules import (
     half_unit,
     in_prediction,
     intervals_overlap,
-    is_slip,
     order_of_magnitude,
     within_points,
 )
@@ -92,15 +92,6 @@ def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[fl
     return replace(column, ok=check(mean, ci), interval=interval, interval_text=interval_text, vacuous=vacuous)
 
 
-def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
-    """The sentence naming a slip between the authors' output and the print ("" when none).
-    ``printed`` as printed (a percentage for a ratio: ``scale`` 100 brings the output there)."""
-    if out.value is None or not out.complete or not is_slip(scale * out.value, printed):
-        return ""
-    return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
-            f"({out.source}), the thesis prints {show(float(printed))}.")
-
-
 def _said(column: AuthorsColumn) -> str:
     """Ours under the authors' settings as a note quotes it."""
     return "(not stored yet)" if not column.experiment or column.text == "-" else column.text
@@ -119,19 +110,12 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
                     tail: Mapping[tuple[float, int, float], TailRuns] | None = None,
                     tail_exp: Experiment | None = None, tail_rep: Mapping[str, Any] | None = None) -> None:
     """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the authors'
-    settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed theta_0, found
-    before their outputs were read) is quoted in the explanation; ``tail`` places a print among ours.
-
-    A cell that ``tail_exp`` runs again under the authors' settings with more seeds is judged on
-    those runs once they are all stored: the larger sample decides, not the five seeds of
-    ``authors`` (with five, the verdict on the cell the tail runs were made for changed with the
-    seeds, while the fifty placed the print outside every time)."""
+    settings (their theta_0 and counting; a cell ``tail_exp`` ran again with more seeds, on those once
+    all are stored: five seeds' verdict there followed the seeds) and their output; ``exp`` (our
+    reconstructed theta_0) is quoted in the explanation; ``tail`` places a print among ours."""
     recon = {_cell(c): r for c, r in zip(exp.configs, rep["configs"])}
-    theirs = {_cell(c): (authors, r)
-              for c, r in zip(authors.configs if authors else (), (authors_rep or {}).get("configs", []))}
-    for c, r in zip(tail_exp.configs if tail_exp else (), (tail_rep or {}).get("configs", [])):
-        if tail_exp is not None and r["seeds"] >= tail_exp.seeds:
-            theirs[_cell(c)] = (tail_exp, r)
+    theirs = {_cell(c): (e, r) for e, er in ((authors, authors_rep), (tail_exp, tail_rep)) if e is not None
+              for c, r in zip(e.configs, (er or {}).get("configs", [])) if e is authors or r["seeds"] >= e.seeds}
     starts = Theta0s(printed_theta0=f"{T51_PRINTED_THETA0:g}", authors_theta0=f"{AUTHORS_T51_THETA0:g}")
     for c, r in zip(printed.configs, printed_rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
@@ -166,7 +150,7 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
                               f"our prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} "
                               "(where all 24 of their output files start), counted as they counted (strict increases "
                               "over 10^6/N - 1 updates), it is inside." + recon_text),
-              slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
+              slip_note=slip_sentence(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
               fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]}, output=out,
               note_id="table-5.1/tail" if key in (tail or {}) else None, note_values=(tail or {}).get(key, starts)))
 
@@ -234,7 +218,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   "(lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
                   f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
-              slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
+              slip_note=slip_sentence(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
               fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range, "delta": delta,
                       "theoretical_range": None if theoretical else method_of(c, Adaptive).error.theoretical_range,
                       "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
@@ -326,7 +310,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                 # Without a seed the row is not judged, and its note, which quotes them, not filled.
                 final = FinalTheta(out.text, f"{seeds.min():.6g} to {seeds.max():.6g}") if seeds.size else None
                 b.add(RowSpec(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}", output=out,
-                      slip_note=_slip(out, text, lambda v: f"{v:.6g}"),
+                      slip_note=slip_sentence(out, text, lambda v: f"{v:.6g}"),
                       where="Section 5.2.1 (after Figure 5.5)", thesis=text,
                       ours="-" if mean is None else
                       f"{mean:.6g} (seeds {seeds.min():.6g} to {seeds.max():.6g})",
@@ -372,7 +356,8 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   page=page, heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
                   interval=pi, interval_text=pi_text(pi, fmt, r["seeds"]),
-                  authors=replace(a_col, note=authors_note), slip_note="" if out is None else _slip(out, text, fmt),
+                  authors=replace(a_col, note=authors_note),
+                  slip_note="" if out is None else slip_sentence(out, text, fmt),
                   remark=_missing(out) or _also(also, other, "upsilon_bar", fmt, text),
                   output=out, note_values=note_values))
         if "improvement_ratio" in th:
@@ -397,7 +382,8 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   vacuous=frozen(r.get("theta_moved")),
                   fields={"method": c.name, "quantity": "improvement_ratio"},
                   authors=replace(a_col, note=authors_note),
-                  slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
+                  slip_note="" if out is None else slip_sentence(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%",
+                                                                 100),
                   remark=_missing(out) or _also(also, other, "improvement_ratio", pct, f"{100 * thesis:.6g}", 100),
                   output=out, note_values=note_values))
 
@@ -474,7 +460,7 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
               page="lqg2d", heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
               interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
               expected_seeds=seeds, authors=replace(a_col, note=note),
-              slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
+              slip_note=slip_sentence(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
                exponent=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
