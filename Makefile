@@ -44,6 +44,7 @@ browser-deps:
 # notebooks are checked by nbval.
 lint: setup-dev
 	$(VPY) -m ruff check safepg tests benchmarks book/tools book/_ext
+	$(VPY) -m mypy
 
 # The book first, as `make book` builds it (its computations use every core), then the tests on every
 # core (pytest-xdist; a test file's tests run in one worker, in order: nbval's cells need that).

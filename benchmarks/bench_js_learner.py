@@ -66,13 +66,14 @@ function time(f) {  // best of `repeat`, after one warm-up call
   return {wall_ms: wall, cpu_ms: c};
 }
 const out = {};
-const ws = new L.Workspace(20), rng = new L.Rng(0, 0), draw = L.rngDraw(rng, L.THESIS_1D);
-for (const est of ["gpomdp", "reinforce"])
-  out["batch_1e5_" + est] = time(() => L.gradientSamples(-0.3, 1, 100000, L.THESIS_1D,
-                                                       {estimator: est, baseline: true, score: "clipped"}, ws, draw));
-let seed = 0;
-out.run_1e6 = time(() => new L.Run({bound: "bernstein", empiricalRange: true, budget: 1000000, seed: seed++}).finish());
 const vec = JSON.parse(process.argv[4]);
+const batch1 = new L.LqgBatch(vec.lqg1d), src1 = L.rngSource(new L.Rng(0, 0)), theta1 = Float64Array.of(-0.3);
+for (const est of ["gpomdp", "reinforce"])
+  out["batch_1e5_" + est] = time(() => batch1.run(theta1, 1, 100000,
+                                                  {estimator: est, baseline: true, scoreAction: "clipped"}, src1));
+let seed = 0;
+out.run_1e6 = time(() => new L.VectorRun({bound: "bernstein", range: "empirical", budget: 1000000, seed: seed++},
+                                         vec.lqg1d).finish());
 Object.assign(out, vectorBench(L, vec, time));
 L.lqg2dWasm.enabled = false;
 out.lqg2d_fig57_tenth_javascript = time(() => fig57Tenth(L, vec, 7));
@@ -81,7 +82,7 @@ process.stdout.write(JSON.stringify(out));
 #: The two vector-task measurements, shared by Node and the Chromium worker.
 VECTOR_BENCH = r"""
 function fig57Tenth(L, vec, seed) {  // Figure 5.7's adaptive run at a tenth of its budget
-  return new L.VectorRun({bound: "bernstein", empiricalRange: true, budget: 3000000, seed: seed}, vec.lqg2d).finish();
+  return new L.VectorRun({bound: "bernstein", range: "empirical", budget: 3000000, seed: seed}, vec.lqg2d).finish();
 }
 function vectorBench(L, vec, time) {
   const out = {}, star = Float64Array.from(vec.theta);
@@ -90,7 +91,7 @@ function vectorBench(L, vec, time) {
   out.cartpole_1e5 = time(() => {
     steps = 0;
     for (let b = 0; b < 100; b++) {
-      cp.run(star, 1, 1000, {estimator: "gpomdp", baseline: true, score: "clipped"}, cpSrc);
+      cp.run(star, 1, 1000, {estimator: "gpomdp", baseline: true, scoreAction: "clipped"}, cpSrc);
       for (let j = 0; j < 1000; j++) steps += cp.returns[j];
     }
   });
@@ -241,7 +242,8 @@ def main() -> None:
     numba.set_num_threads(1)
     cartpole, lqg2d = CartPole.thesis_doubled(**AUTHORS_DOUBLED), make_env("lqg2d-gamma0.9")
     star = cartpole_theta_star()
-    vec = {"cartpole": cartpole_task_data(cartpole), "lqg2d": lqg_task_data(lqg2d), "theta": star.tolist()}
+    vec = {"cartpole": cartpole_task_data(cartpole), "lqg2d": lqg_task_data(lqg2d),
+           "lqg1d": lqg_task_data(LQG.thesis_1d()), "theta": star.tolist()}
     with tempfile.TemporaryDirectory() as tmp:
         script, learner = Path(tmp) / "bench.js", Path(tmp) / "learner_all.js"
         script.write_text(VECTOR_BENCH + NODE_BENCH)

@@ -32,7 +32,8 @@ def _kernel_cache_dir() -> None:
     parent = Path(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR") else package / "__pycache__"
     if not os.access(parent if parent.exists() else parent.parent, os.W_OK):
         parent = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "safepg"
-    numba.config.CACHE_DIR = str(parent / f"numba-{digest.hexdigest()[:16]}")
+    # numba.config sets its names at run time (from the environment), so its stubs do not list them.
+    vars(numba.config)["CACHE_DIR"] = str(parent / f"numba-{digest.hexdigest()[:16]}")
 
 
 _kernel_cache_dir()
@@ -55,6 +56,7 @@ from safepg.meta import (
 )
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
+from safepg.record import on_trajectories
 from safepg.trajectories import Trajectories
 
 #: The package's version.
@@ -87,6 +89,7 @@ __all__ = [
     "n_star_closed_form",
     "n_star_search",
     "n_zero",
+    "on_trajectories",
     "optimal_batch_size",
     "penalty_constant",
     "reinforce",

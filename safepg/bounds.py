@@ -173,7 +173,11 @@ def error_bound(
     elif range == "lemma":
         grad_range = gradient_range_bound(constants)
     else:
-        grad_range = check_range(range)
+        grad_range = float(check_range(range))  # a number here: the strings were handled above
     if bound == "hoeffding":
         return hoeffding(delta, grad_range)
     return bernstein(delta, float(np.var(samples, ddof=1)) if variance is None else float(variance), grad_range)
+
+
+__all__ = ["BOUNDS", "Bound", "ErrorBound", "Range", "bernstein", "chebyshev", "check_delta", "check_range",
+           "error_bound", "gpomdp_variance_factor", "gradient_range_bound", "hoeffding", "reinforce_variance_factor"]

@@ -17,12 +17,13 @@ from typing import Any
 import numpy as np
 
 from safepg.envs.lqg import LQG
-from safepg.learning import adaptive_pg, vanilla_pg
-from safepg.options import Batches, ErrorModel, FixedStep, Gradient
+from safepg.learning import learn
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.store import DamagedRunsError, DamagedRunWarning, results_dir
 from safepg.thesis import experiment_store, experiments, report
 
-ENVS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
+#: The tasks of ``learn`` (those with a closed-form J, which its summary reports).
+TASKS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
 
 
 def integer(text: str) -> int:
@@ -68,47 +69,84 @@ def jobs_integer(text: str) -> int:
     return value
 
 
-def _learn_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("learn", help="run one learning loop and print a JSON summary")
-    p.add_argument("--env", choices=sorted(ENVS), default="lqg1d")
-    p.add_argument("--estimator", choices=["reinforce", "gpomdp"], default="gpomdp")
-    p.add_argument("--no-baseline", action="store_true", help="use b = 0")
-    p.add_argument("--bound", choices=["chebyshev", "hoeffding", "bernstein"], default="chebyshev")
-    p.add_argument("--empirical-range", action="store_true")
-    p.add_argument("--delta", type=float, default=0.95)
-    p.add_argument("--sigma", type=float, default=1.0)
+def range_value(text: str) -> str | float:
+    """argparse type of ``--range``: ``lemma``, ``empirical`` or a number (ErrorModel.range)."""
+    if text in ("lemma", "empirical"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be 'lemma', 'empirical' or a number, got {text!r}") from None
+
+
+def _learn_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    # Each flag is a field of an option object (safepg.options), spelt as that field.
+    p = sub.add_parser("learn", help="run one learning loop and print a JSON summary",
+                       description="Algorithm 4.1 (Adaptive), or vanilla PG with --batch-size (Vanilla). Each "
+                                   "flag is the field of the option object named in its group.")
+    p.add_argument("--task", choices=sorted(TASKS), default="lqg1d")
     p.add_argument("--theta0", type=float, nargs="+", default=[0.0])
+    p.add_argument("--sigma", type=float, default=1.0)
     p.add_argument("--budget", type=positive_integer, default=30_000_000, help="total trajectories (3e7 is fine)")
-    p.add_argument("--n-min", type=positive_integer, default=100)
-    p.add_argument("--n-max", type=positive_integer, default=500_000)
-    p.add_argument("--fixed-alpha", type=float, help="vanilla PG with this step size")
-    p.add_argument("--fixed-n", type=positive_integer, help="vanilla PG with this batch size")
-    p.add_argument("--step", choices=["scalar", "coordinate"], default="scalar",
-                   help="vanilla PG: update all components or only the largest")
-    p.add_argument("--score-action", choices=["clipped", "raw"], default="clipped",
-                   help="score the clipped action (authors' code) or the sampled one (unbiased)")
     p.add_argument("--seed", type=nonnegative_integer, default=0)
+    p.add_argument("--stop-on-divergence", action="store_true",
+                   help="end the run when the gradient estimate is not finite (default: an error)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    g = p.add_argument_group("Gradient")
+    g.add_argument("--estimator", choices=["reinforce", "gpomdp"], default="gpomdp")
+    g.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
+                   help="the variance-minimising baseline (--no-baseline: b = 0)")
+    g.add_argument("--score-action", choices=["clipped", "raw"], default="clipped",
+                   help="score the clipped action (authors' code) or the sampled one (unbiased)")
+    g = p.add_argument_group("ErrorModel (Algorithm 4.1, or a SafeStep)")
+    g.add_argument("--bound", choices=["chebyshev", "hoeffding", "bernstein"], default="chebyshev")
+    g.add_argument("--delta", type=float, default=0.95)
+    g.add_argument("--range", type=range_value, default="lemma", help="lemma, empirical, or a number")
+    g = p.add_argument_group("Batches (Algorithm 4.1)")
+    g.add_argument("--n-min", type=positive_integer, default=100)
+    g.add_argument("--n-max", type=positive_integer, default=500_000)
+    g.add_argument("--first", type=positive_integer, help="the first batch's size (default: N_min)")
+    g = p.add_argument_group("Departures (Algorithm 4.1, the authors' ways of running it)")
+    for name in ("batch_constants", "maxima", "unguarded_step"):
+        g.add_argument(f"--{name.replace('_', '-')}", action="store_true")
+    g = p.add_argument_group("Vanilla (fixed batch size)")
+    g.add_argument("--batch-size", type=positive_integer, help="run vanilla PG with this batch size")
+    g.add_argument("--alpha", type=float, help="FixedStep: the step size")
+    g.add_argument("--safe-step", choices=["scalar", "coordinate"],
+                   help="SafeStep of this kind, with the ErrorModel flags, instead of a fixed alpha")
+    g.add_argument("--kind", choices=["scalar", "coordinate"], default="scalar",
+                   help="FixedStep: update all components or only the largest")
+    g.add_argument("--target", type=float, help="Target: stop once a batch's mean return reaches it")
+    g.add_argument("--update", action="store_true", help="Target: the batch that reaches it still updates theta")
 
 
-def _run_learn(args: argparse.Namespace) -> dict:
-    env = ENVS[args.env]()
+def _method(args: argparse.Namespace) -> Adaptive | Vanilla:
+    """The method the ``learn`` flags describe, as option objects (each checks its own values)."""
+    gradient = Gradient(args.estimator, args.baseline, args.score_action)
+    error = ErrorModel(args.bound, args.delta, args.range)
+    if args.batch_size is None:
+        for flag in ("alpha", "safe_step", "target"):
+            if getattr(args, flag) is not None:
+                raise ValueError(f"--{flag.replace('_', '-')} is an option of vanilla PG: give --batch-size too")
+        return Adaptive(gradient, error, Batches(args.n_min, args.n_max, args.first),
+                        Departures(args.batch_constants, args.maxima, args.unguarded_step))
+    if (args.alpha is None) == (args.safe_step is None):
+        raise ValueError("--batch-size needs a step: --alpha (a FixedStep) or --safe-step (a SafeStep)")
+    step = FixedStep(args.alpha, args.kind) if args.alpha is not None else SafeStep(args.safe_step, error)
+    return Vanilla(args.batch_size, step, gradient, None if args.target is None else Target(args.target, args.update))
+
+
+def _run_learn(args: argparse.Namespace) -> dict[str, Any]:
+    task = TASKS[args.task]()
     theta0 = np.asarray(args.theta0, dtype=float)
     if theta0.size == 1:
-        theta0 = np.full(env.dim**2, theta0[0]) * np.eye(env.dim).ravel() if env.dim > 1 else theta0
-    gradient = Gradient(args.estimator, not args.no_baseline, args.score_action)
-    common = dict(gradient=gradient, budget=args.budget, rng=args.seed, progress=not args.quiet)
-    if args.fixed_alpha is not None or args.fixed_n is not None:
-        if args.fixed_alpha is None or args.fixed_n is None:
-            raise ValueError("--fixed-alpha and --fixed-n must be given together for vanilla PG")
-        rec = vanilla_pg(env, theta0, args.sigma, batch_size=args.fixed_n, step=FixedStep(args.fixed_alpha, args.step),
-                         **common)
-    else:
-        error = ErrorModel(args.bound, args.delta, "empirical" if args.empirical_range else "lemma")
-        rec = adaptive_pg(env, theta0, args.sigma, error=error, batches=Batches(args.n_min, args.n_max), **common)
+        theta0 = np.full(task.dim**2, theta0[0]) * np.eye(task.dim).ravel() if task.dim > 1 else theta0
+    rec = learn(task, _method(args), theta0, args.sigma, budget=args.budget, rng=args.seed, progress=not args.quiet,
+                stop_on_divergence=args.stop_on_divergence)
     out = rec.summary()
-    out["J_star"] = env.performance(env.optimal_gain(), args.sigma)
-    out["theta_star"] = env.optimal_gain().ravel().tolist()
+    out["J_star"] = task.performance(task.optimal_gain(), args.sigma)
+    out["theta_star"] = task.optimal_gain().ravel().tolist()
+    out["config"] = rec.config
     return out
 
 
@@ -120,8 +158,10 @@ class DamagedStoreError(LookupError):
     """``report`` found damaged run files (the CLI names each, says how to repair, exits with status 1)."""
 
 
-def _experiment_parsers(sub: argparse._SubParsersAction) -> None:
+def _experiment_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("list", help="name every experiment")
+    p.add_argument("--json", action="store_true",
+                   help="every experiment's configurations with their definitions and run keys, as JSON")
     p.set_defaults(func=_cmd_list)
     p = sub.add_parser("run", help="run an experiment (resumes; finished runs are kept)")
     p.add_argument("name")
@@ -151,9 +191,14 @@ def _run_command(args: argparse.Namespace) -> str:
     return f"python -m safepg run {args.name}{extra}"
 
 
-def _cmd_list(args: argparse.Namespace) -> None:
+def _cmd_list(args: argparse.Namespace) -> dict[str, Any] | None:
+    if args.json:
+        return {e.name: {"description": e.description, "seeds": e.seeds,
+                         "configs": {c.name: {"key": c.key(), "definition": c.definition()} for c in e.configs}}
+                for e in experiments.EXPERIMENTS.values()}
     for e in experiments.EXPERIMENTS.values():
         print(f"{e.name:12s} {len(e.configs):3d} configs x {e.seeds} seeds  {e.description}")
+    return None
 
 
 def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:

@@ -9,17 +9,30 @@ import numpy as np
 
 from safepg import portable
 
-#: Values of :attr:`TaskConstants.horizon_term`.
+#: Values of the ``horizon_term`` of :class:`TaskConstants`.
 HORIZON_TERMS = ("effective", "truncated", "horizon")
 
 
 class BoundedTask(Protocol):
-    reward_bound: float
-    feature_bound: float
-    action_volume: float
-    action_bound: float
-    gamma: float
-    horizon: int
+    """A task's bounds of Assumption 4.2.1 and its horizon: read-only, as attributes or properties."""
+
+    @property
+    def reward_bound(self) -> float: ...
+
+    @property
+    def feature_bound(self) -> float: ...
+
+    @property
+    def action_volume(self) -> float: ...
+
+    @property
+    def action_bound(self) -> float: ...
+
+    @property
+    def gamma(self) -> float: ...
+
+    @property
+    def horizon(self) -> int: ...
 
 
 @dataclass(frozen=True)
@@ -104,3 +117,6 @@ class TaskConstants:
             sigma=float(sigma),
             horizon_term=getattr(task, "horizon_term", "effective"),
         )
+
+
+__all__ = ["BoundedTask", "HORIZON_TERMS", "TaskConstants"]

@@ -66,7 +66,8 @@ def reinforce(
     total_score = scores.sum(axis=1)  # (N, m)
     returns = np.sum(rewards * portable.powers(gamma, rewards.shape[1]), axis=1)  # (N,)
     b = reinforce_baseline(total_score, returns) if baseline else np.zeros(scores.shape[2])
-    return total_score * (returns[:, None] - b[None, :])
+    samples: np.ndarray = total_score * (returns[:, None] - b[None, :])
+    return samples
 
 
 def gpomdp_baseline(cum_score: np.ndarray, disc_rewards: np.ndarray) -> np.ndarray:
@@ -95,8 +96,10 @@ def gpomdp(
     disc_rewards = rewards * portable.powers(gamma, rewards.shape[1])  # (N, H)
     if baseline:
         b = gpomdp_baseline(cum_score, disc_rewards)
-        return np.einsum("nhm,nhm->nm", cum_score, disc_rewards[:, :, None] - b[None])
-    return np.einsum("nhm,nh->nm", cum_score, disc_rewards)
+        samples: np.ndarray = np.einsum("nhm,nhm->nm", cum_score, disc_rewards[:, :, None] - b[None])
+    else:
+        samples = np.einsum("nhm,nh->nm", cum_score, disc_rewards)
+    return samples
 
 
 def _check_shapes(scores: np.ndarray, rewards: np.ndarray) -> None:
@@ -136,3 +139,7 @@ def gradient_samples(
         return reinforce(scores, batch.rewards, batch.gamma, baseline)
     check_estimator(estimator)
     return gpomdp(scores, batch.rewards, batch.gamma, baseline)
+
+
+__all__ = ["ESTIMATORS", "Estimator", "SCORE_ACTIONS", "ScoreAction", "check_estimator", "check_score_action", "gpomdp",
+           "gpomdp_baseline", "gradient_samples", "reinforce", "reinforce_baseline", "trajectory_scores"]

@@ -17,6 +17,7 @@ from tqdm.auto import tqdm
 
 from safepg.bounds import ErrorBound, error_bound
 from safepg.constants import TaskConstants
+from safepg.definition import run_definition
 from safepg.estimators import gradient_samples
 from safepg.meta import (
     coordinate_step,
@@ -45,7 +46,7 @@ class _Update:
 
 #: (samples (n, m), their mean, n, the batch's measured (R, M_phi) or None) -> the update.
 #: The loop computes the mean once.
-UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"], _Update]
+_UpdateRule = Callable[[np.ndarray, np.ndarray, int, "tuple[float, float] | None"], _Update]
 #: ``progress`` of the learning loops: True for a tqdm bar, or a callable ``report(used, budget)``.
 Progress = bool | Callable[[int, int], object]
 
@@ -61,28 +62,28 @@ def _closed_form(hooks: Hooks, thetas: np.ndarray, sigma: float) -> np.ndarray:
 
 def _collect(
     task: Task, hooks: Hooks, policy: LinearGaussianPolicy, n: int, rng: np.random.Generator, gradient: Gradient,
-    maxima: bool = False,
+    batch_constants: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, tuple[float, float] | None]:
-    """Gradient samples (n, m), measured returns (n,) and, with ``maxima``, the batch's
+    """Gradient samples (n, m), measured returns (n,) and, with ``batch_constants``, the batch's
     measured (R, M_phi) (else None) of a fresh batch.
 
     Uses the task's fused ``gradient_batch`` when it has one (the LQG and the cart-pole
     do), else simulates the batch and applies :func:`safepg.estimators.gradient_samples`.
     The measured return is the task's ``measured_returns(batch)`` if it defines one (the
     cart-pole: the undiscounted episode length the thesis reports), else the discounted
-    return. With ``maxima``: the task's ``gradient_batch_maxima`` if it has one (the
+    return. With ``batch_constants``: the task's ``gradient_batch_constants`` if it has one (the
     cart-pole), else the largest |reward| and |feature| of the simulated batch's live steps.
     """
     how = (gradient.estimator, gradient.baseline, gradient.score_action)
-    if maxima:
-        if hooks.gradient_batch_maxima is not None:
-            return hooks.gradient_batch_maxima(policy, n, rng, *how)
+    if batch_constants:
+        if hooks.gradient_batch_constants is not None:
+            return hooks.gradient_batch_constants(policy, n, rng, *how)
     elif hooks.gradient_batch is not None:
         return (*hooks.gradient_batch(policy, n, rng, *how), None)
     batch = task.simulate(policy, n, rng)
     measured = hooks.measured_returns or Trajectories.discounted_returns
     found = None
-    if maxima:
+    if batch_constants:
         live = np.ones(batch.rewards.shape, dtype=bool) if batch.mask is None else batch.mask.astype(bool)
         found = (float(np.abs(batch.rewards[live]).max()), float(np.abs(batch.features[live]).max()))
     return gradient_samples(policy, batch, *how), measured(batch), found
@@ -97,7 +98,7 @@ def _learn(
     task: Task,
     hooks: Hooks,
     policy: LinearGaussianPolicy,
-    rule: UpdateRule,
+    rule: _UpdateRule,
     n_first: int,
     budget: int,
     rng: RNGLike,
@@ -106,7 +107,7 @@ def _learn(
     progress: Progress,
     stop_on_divergence: bool = False,
     target: Target | None = None,
-    maxima: bool = False,
+    batch_constants: bool = False,
 ) -> LearningRecord:
     rng = as_generator(rng)
     theta = policy.theta
@@ -124,7 +125,7 @@ def _learn(
             n = min(n, budget - used)
             if n < 2:
                 break
-            samples, returns, found = _collect(task, hooks, policy, n, rng, gradient, maxima)
+            samples, returns, found = _collect(task, hooks, policy, n, rng, gradient, batch_constants)
             with np.errstate(over="ignore", invalid="ignore"):  # a non-finite mean is handled just below
                 # sum / n is what ndarray.mean computes (same bits), without its Python overhead:
                 # a run with N = 100 has 3*10^5 iterations.
@@ -205,6 +206,7 @@ def adaptive_pg(
     budget: int = 30_000_000,
     rng: RNGLike = None,
     progress: Progress = False,
+    stop_on_divergence: bool = False,
 ) -> LearningRecord:
     r"""Adaptive policy gradient, Algorithm 4.1 (as corrected in the book's errata).
 
@@ -242,12 +244,16 @@ def adaptive_pg(
         after each batch with the trajectories used so far. An exception it raises stops
         the run and propagates to the caller, with no record: how a caller running the loop
         in a thread cancels it (one call per batch, so cancelling waits for one batch).
+    stop_on_divergence : bool
+        When a gradient estimate is not finite, end the run and return its record with
+        ``diverged`` set, instead of raising ``ValueError``.
 
     Returns
     -------
     LearningRecord
-        The per-iteration arrays; ``config`` holds the settings (``config["c"]`` is the
-        penalty constant from the task's bounds).
+        The per-iteration arrays; ``config`` holds the run's definition
+        (:func:`safepg.definition.run_definition`) and ``config["c"]``, the penalty constant
+        from the task's bounds.
     """
     method = Adaptive(gradient, error, batches, departures)  # checks each option's type
     first = batches.first_size
@@ -276,16 +282,9 @@ def adaptive_pg(
         step[k] = alpha * grad[k]
         return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, batches.n_min, batches.n_max))
 
-    config = dict(
-        algorithm="adaptive", task=repr(task), theta0=np.asarray(theta0, float).tolist(), sigma=sigma,
-        estimator=gradient.estimator, baseline=gradient.baseline, bound=error.bound, delta=error.delta,
-        empirical_range=error.empirical_range, theoretical_range=error.theoretical_range, n_min=batches.n_min,
-        n_max=batches.n_max, budget=budget, score_action=gradient.score_action, c=c_bounds,
-    )
-    # The departures only when taken, so a default run's record is what it always was.
-    config.update(method.departure_fields())
-    return _learn(task, hooks, policy, rule, first, budget, rng, gradient, config, progress,
-                  maxima=departures.batch_constants)
+    config = {**run_definition(task, method, theta0, sigma, budget, stop_on_divergence, exact=False), "c": c_bounds}
+    return _learn(task, hooks, policy, rule, first, budget, rng, gradient, config, progress, stop_on_divergence,
+                  batch_constants=departures.batch_constants)
 
 
 def vanilla_pg(
@@ -345,20 +344,19 @@ def vanilla_pg(
     LearningRecord
         The per-iteration arrays and the settings in ``config``.
     """
-    Vanilla(batch_size, step, gradient, target)  # checks batch_size and each option's type
+    method = Vanilla(batch_size, step, gradient, target)  # checks batch_size and each option's type
     _check_budget(budget, batch_size)
     hooks = task_hooks(task)
     policy = _initial_policy(hooks, theta0, sigma)
     constants = TaskConstants.from_task(task, policy.sigma)
     c = penalty_constant(constants)
-    safe_step = step if isinstance(step, SafeStep) else None
 
     def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
         k = int(np.argmax(np.abs(grad)))
-        if safe_step is None:
+        if isinstance(step, FixedStep):
             eps, safe, a = 0.0, True, step.alpha
         else:
-            e = safe_step.error
+            e = step.error
             # One common eps for all components: the largest per-component bound.
             eps = max(float(error_bound(e.bound, samples[:, i], e.delta, constants, gradient.estimator,
                                         e.range).eps(n)) for i in range(grad.size))
@@ -370,29 +368,18 @@ def vanilla_pg(
         d[k] = a * grad[k]
         return _Update(d, a, k, eps, safe, batch_size)
 
-    e = safe_step.error if safe_step is not None else ErrorModel()
-    config = dict(
-        algorithm="vanilla", task=repr(task), theta0=np.asarray(theta0, float).tolist(),
-        sigma=sigma, batch_size=batch_size, alpha=None if safe_step is not None else step.alpha, step=step.kind,
-        estimator=gradient.estimator, baseline=gradient.baseline, bound=e.bound, delta=e.delta,
-        empirical_range=e.empirical_range, budget=budget, score_action=gradient.score_action, c=c,
-        target_return=None if target is None else target.value,
-    )
-    if e.theoretical_range is not None:
-        config["theoretical_range"] = e.theoretical_range
-    if target is not None and target.update:  # only when set, so a default run's record is what it always was
-        config["update_at_target"] = True
+    config = {**run_definition(task, method, theta0, sigma, budget, stop_on_divergence, exact=False), "c": c}
     return _learn(task, hooks, policy, rule, batch_size, budget, rng, gradient, config, progress,
                   stop_on_divergence, target)
 
 
 def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
-          budget: int, rng: RNGLike = None, progress: Progress = False) -> LearningRecord:
+          budget: int, rng: RNGLike = None, progress: Progress = False,
+          stop_on_divergence: bool = False) -> LearningRecord:
     """Run ``method`` on ``task``: :func:`adaptive_pg` for an :class:`~safepg.options.Adaptive`,
-    :func:`vanilla_pg` for a :class:`~safepg.options.Vanilla`.
-
-    A fixed step may make theta diverge; that is a result to report, so a vanilla run then
-    ends with ``diverged`` set instead of raising (``stop_on_divergence=True``).
+    :func:`vanilla_pg` for a :class:`~safepg.options.Vanilla`, with the same divergence
+    behaviour for both: raise ``ValueError``, or with ``stop_on_divergence`` end the run
+    with ``diverged`` set (a campaign's runs do: :class:`safepg.runner.RunConfig`).
 
     Parameters
     ----------
@@ -400,7 +387,7 @@ def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0
         As in :func:`adaptive_pg`.
     method : Adaptive or Vanilla
         The method with all its options.
-    theta0, sigma, budget, rng, progress
+    theta0, sigma, budget, rng, progress, stop_on_divergence
         As in :func:`adaptive_pg`.
 
     Returns
@@ -410,13 +397,13 @@ def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0
     if isinstance(method, Adaptive):
         return adaptive_pg(task, theta0, sigma, gradient=method.gradient, error=method.error,
                            batches=method.batches, departures=method.departures, budget=budget, rng=rng,
-                           progress=progress)
+                           progress=progress, stop_on_divergence=stop_on_divergence)
     if isinstance(method, Vanilla):
         return vanilla_pg(task, theta0, sigma, batch_size=method.batch_size, step=method.step,
                           gradient=method.gradient, target=method.target, budget=budget, rng=rng, progress=progress,
-                          stop_on_divergence=True)
+                          stop_on_divergence=stop_on_divergence)
     raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "adaptive_pg", "guaranteed_improvement", "learn",
-           "vanilla_pg"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "Progress", "RecordFileError", "adaptive_pg", "guaranteed_improvement",
+           "learn", "vanilla_pg"]

@@ -135,8 +135,9 @@ def n_zero(g: float, bound: ErrorBound) -> float:
     return root * root
 
 
-def n_star_closed_form(g: float, bound: ErrorBound) -> int:
-    r"""Optimal batch size of Theorem 4.3.2 when :math:`\epsilon = d_\delta/\sqrt N` (f = 0).
+def n_star_closed_form(g: float, bound: ErrorBound) -> float:
+    r"""Optimal batch size of Theorem 4.3.2 when :math:`\epsilon = d_\delta/\sqrt N` (f = 0): an integer,
+    or ``math.inf`` when g = 0 (no batch makes the step safe).
 
     .. math:: N^* = \Big\lceil \frac{(13 + 3\sqrt{17})\, d_\delta^2}{2\|\hat\nabla J\|_\infty^2}\Big\rceil
     """
@@ -144,12 +145,13 @@ def n_star_closed_form(g: float, bound: ErrorBound) -> int:
         raise ValueError("f must be 0 for the closed-form N* (use n_star_search for Bernstein)")
     g = _check_g(g)
     if g == 0:
-        return math.inf  # type: ignore[return-value]
+        return math.inf
     return math.ceil(N_STAR_FACTOR * (bound.d * bound.d) / (g * g))
 
 
-def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = None) -> int:
-    """N* by the linear search of Section 4.3.3 (any f >= 0).
+def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = None) -> float:
+    """N* by the linear search of Section 4.3.3 (any f >= 0): an integer, or ``math.inf`` when
+    g = 0 and no ``n_max`` is given.
 
     Start at ceil(N_0) and stop as soon as Upsilon begins to decrease; the stationary
     point is unique (Descartes' rule of signs), so this is the global maximiser on
@@ -158,7 +160,7 @@ def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = Non
     """
     g = _check_g(g)
     if g == 0:
-        return math.inf if n_max is None else n_max  # type: ignore[return-value]
+        return math.inf if n_max is None else n_max
     start = max(1, math.ceil(n_zero(g, bound)))
     if n_max is not None and start >= n_max:
         return n_max
@@ -190,7 +192,7 @@ def n_star_bernstein_root(g: float, bound: ErrorBound) -> float:
     d, f = bound.d, bound.f
     roots = np.roots([-(g**2), 3 * d * g, 2 * d * d + 6 * f * g, 5 * d * f, 3 * f * f])
     pos = [r.real for r in roots if abs(r.imag) < 1e-9 * max(1.0, abs(r)) and r.real > 0]
-    return max(pos) ** 2
+    return float(max(pos) ** 2)
 
 
 def optimal_batch_size(
@@ -201,4 +203,11 @@ def optimal_batch_size(
     n = n_star_closed_form(g, bound) if bound.f == 0 else n_star_search(g, bound, c, n_max)
     if n_max is not None:
         n = min(n, n_max)
+    elif math.isinf(n):
+        raise ValueError("n_max must be given when the gradient estimate is 0: N* is then infinite")
     return int(max(n_min, n))
+
+
+__all__ = ["ALPHA_STAR_FACTOR", "N_STAR_FACTOR", "coordinate_step", "guaranteed_improvement", "n_star_bernstein_root",
+           "n_star_closed_form", "n_star_search", "n_zero", "optimal_batch_size", "penalty_constant", "scalar_step",
+           "upsilon"]

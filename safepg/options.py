@@ -299,21 +299,6 @@ class Adaptive:
                 article = "an" if kind.__name__[0] in "AEIOU" else "a"
                 raise TypeError(f"{name} must be {article} {kind.__name__}, got {getattr(self, name)!r}")
 
-    def departure_fields(self) -> dict[str, object]:
-        """The options set away from Algorithm 4.1, under the names the records and the run keys
-        have always used (``n_first``, ``constants``, ``statistics``, ``step_when_unsafe``); an
-        option at the algorithm's value is absent."""
-        fields: dict[str, object] = {}
-        if self.batches.first is not None:
-            fields["n_first"] = self.batches.first
-        if self.departures.batch_constants:
-            fields["constants"] = "batch"
-        if self.departures.maxima:
-            fields["statistics"] = "max"
-        if self.departures.unguarded_step:
-            fields["step_when_unsafe"] = True
-        return fields
-
 
 @dataclass(frozen=True)
 class Vanilla:

@@ -103,14 +103,16 @@ class LinearGaussianPolicy:
         """Draw a ~ N(K phi(s), Sigma) for each row of ``features``."""
         rng = as_generator(rng)
         noise = rng.standard_normal(features.shape[:-1] + (self.action_dim,))
-        return self.mean(features) + portable.matmul(noise, self.cov_chol.T)
+        actions: np.ndarray = self.mean(features) + portable.matmul(noise, self.cov_chol.T)
+        return actions
 
     def log_density(self, features: np.ndarray, actions: np.ndarray) -> np.ndarray:
         """log pi_theta(a | s), shape features.shape[:-1]."""
         diff = actions - self.mean(features)
         maha = np.einsum("...i,ij,...j->...", diff, self.precision, diff)
         _, logdet = np.linalg.slogdet(2 * np.pi * self.cov)
-        return -0.5 * (maha + logdet)
+        log_pi: np.ndarray = -0.5 * (maha + logdet)
+        return log_pi
 
     def score(self, features: np.ndarray, actions: np.ndarray) -> np.ndarray:
         r"""Eligibility vector :math:`\nabla_\theta \log\pi_\theta(a\mid s)` (Section 2.3.13).
@@ -120,5 +122,8 @@ class LinearGaussianPolicy:
         flattened row-major to shape (..., m) with m = d_a * d_phi.
         """
         diff = portable.matmul(actions - self.mean(features), self.precision)  # precision is symmetric
-        outer = diff[..., :, None] * features[..., None, :]
+        outer: np.ndarray = diff[..., :, None] * features[..., None, :]
         return outer.reshape(features.shape[:-1] + (self.gain.size,))
+
+
+__all__ = ["LinearGaussianPolicy", "check_sigma"]

@@ -71,7 +71,7 @@ def matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     if a.ndim < 2 or b.ndim < 2 or a.shape[-1] != b.shape[-2]:
         raise ValueError(f"b must be a matrix with {a.shape[-1] if a.ndim else '?'} rows "
                          f"to multiply a {a.shape}, got {b.shape}")
-    out = a[..., :, 0:1] * b[..., 0:1, :]
+    out: np.ndarray = a[..., :, 0:1] * b[..., 0:1, :]
     for k in range(1, a.shape[-1]):
         out = out + a[..., :, k:k + 1] * b[..., k:k + 1, :]
     return out
@@ -329,7 +329,8 @@ def exp_kernel(x: float) -> float:
     for d in (6227020800.0, 479001600.0, 39916800.0, 3628800.0, 362880.0, 40320.0, 5040.0, 720.0, 120.0,
               24.0, 6.0, 2.0, 1.0, 1.0):
         p = p * r + 1.0 / d
-    return p * _POW2[int(k) - _POW2_MIN]
+    scale: float = _POW2[int(k) - _POW2_MIN]
+    return p * scale
 
 
 @njit(cache=True)

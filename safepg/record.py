@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import zipfile
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -114,7 +115,8 @@ class LearningRecord:
 
     @property
     def theta_final(self) -> np.ndarray:
-        return self.theta[-1]
+        last: np.ndarray = self.theta[-1]
+        return last
 
     def upsilon_bar(self) -> float:
         r"""Average performance :math:`\overline\Upsilon` (Tables 5.2-5.4): the measured
@@ -126,9 +128,12 @@ class LearningRecord:
         """Share of policy updates after which performance did not decrease.
 
         ``on="J"``: the closed-form J (Section 5.1); ``on="J_hat"``: the batch-average
-        return of consecutive batches (Section 5.3, no closed form).
+        return of consecutive batches (Section 5.3, no closed form). NaN where the performance
+        is unknown (``J`` of a task without a closed form, which is NaN) or nothing was updated.
         """
         perf = self.J if on == "J" else self.J_hat
+        if np.isnan(perf).any():
+            return float("nan")
         with np.errstate(invalid="ignore"):  # -inf to -inf (a diverged run) counts as no improvement
             steps = np.diff(perf)
         if steps.size == 0:
@@ -168,7 +173,8 @@ class LearningRecord:
 
     def save(self, path: str | Path) -> None:
         """Write the record to a compressed ``.npz`` (config as JSON metadata)."""
-        arrays = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
+        # Any: numpy types **kwargs as if one of them could be allow_pickle.
+        arrays: dict[str, Any] = {k: v for k, v in asdict(self).items() if isinstance(v, np.ndarray)}
         meta = json.dumps({"config": self.config, "interrupted": self.interrupted, "diverged": self.diverged,
                            "reached_target": self.reached_target})
         np.savez_compressed(path, meta=np.array(meta), **arrays)
@@ -236,3 +242,28 @@ class LearningRecord:
         except ValueError as err:
             raise RecordFileError(path, f"arrays that do not form one run ({err})") from err
         return rec
+def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequence[int],
+                    field: Literal["J", "J_hat"] = "J") -> np.ndarray:
+    """Several seeds' runs on one axis of trajectories: per run, ``field`` of the iteration whose
+    batch holds trajectory T, for each T of ``grid`` (1-based).
+
+    ``"J"`` is the thesis's "expected performance over sample trajectories" (Figures 5.1-5.2:
+    each iteration's J held for all the trajectories of its batch); ``"J_hat"`` the batch's
+    measured average return (Figure 5.9). Runs of different batch sizes thus line up, and
+    their mean or band over seeds can be taken column by column.
+
+    Returns
+    -------
+    ndarray, shape (len(records), len(grid))
+        NaN past a run's last trajectory.
+    """
+    grid = np.asarray(grid)
+    out = np.full((len(records), grid.size), np.nan)
+    for i, r in enumerate(records):
+        idx = np.searchsorted(np.cumsum(r.batch_size), grid)
+        ok = idx < r.iterations
+        out[i, ok] = getattr(r, field)[idx[ok]]
+    return out
+
+
+__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "on_trajectories"]

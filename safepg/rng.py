@@ -18,3 +18,6 @@ def as_generator(rng: RNGLike) -> np.random.Generator:
     if rng is None or isinstance(rng, (int, np.integer, np.random.SeedSequence)):
         return np.random.default_rng(rng)
     raise TypeError(f"rng must be a numpy Generator, an int seed or None, got {type(rng).__name__}")
+
+
+__all__ = ["RNGLike", "as_generator"]

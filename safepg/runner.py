@@ -27,7 +27,7 @@ import json
 import math
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import KW_ONLY, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -35,15 +35,18 @@ from typing import Any, Literal
 import numpy as np
 from tqdm.auto import tqdm
 
+from safepg.definition import from_dict, run_definition
 from safepg.learning import LearningRecord, learn
-from safepg.options import Adaptive, Batches, ErrorModel, FixedStep, Method, SafeStep, Vanilla
+from safepg.options import Adaptive, Method, Vanilla
 from safepg.store import DamagedRunsError, OnDamaged, load_stored, remove_stale_temp_files, save_atomic
 
 #: Bump when a change to the library alters the numbers a run produces; stored runs with
 #: another version are recomputed. 2: every output computed in a CPU-independent order
 #: (safepg.portable): products instead of libm's pow, software log, sine and cosine.
 #: 3: the kernels draw their own random numbers from counter-based streams (safepg.streams).
-RESULTS_VERSION = "3"
+#: 4: the key hashes the run's whole definition (the task's fields, every option), so each run's
+#: seed stream (RunConfig.seed) changed.
+RESULTS_VERSION = "4"
 
 
 def make_env(name: str) -> Any:
@@ -70,84 +73,86 @@ def make_env(name: str) -> Any:
 
 @dataclass(frozen=True)
 class RunConfig:
-    """One learning run's settings: a method and the task it learns, from a start.
+    """One learning run's definition: a method and the task it learns, from a start, for a budget.
 
     ``method`` is an :class:`~safepg.options.Adaptive` (Algorithm 4.1,
     :func:`~safepg.learning.adaptive_pg`) or a :class:`~safepg.options.Vanilla` (fixed batch
-    size, :func:`~safepg.learning.vanilla_pg`) with all its options. ``env`` names the task; a
-    task :func:`make_env` does not know is built by ``env_factory`` (a picklable callable with
-    no arguments), and ``env`` is then the name that enters the key. ``warm_start`` names the
-    run whose final parameters, seed by seed, start this one, and ``warm_start_key`` is that
-    run's :meth:`key`, so that a changed starting run changes this run's key too.
+    size, :func:`~safepg.learning.vanilla_pg`) with all its options. ``task`` is a task
+    (:class:`~safepg.envs.lqg.LQG`, :class:`~safepg.envs.cartpole.CartPole`,
+    :class:`~safepg.envs.gym_task.GymTask`, or any frozen dataclass task) or the name of one
+    of :func:`make_env`'s. ``stop_on_divergence`` ends a run whose gradient estimate is not
+    finite and records it (``diverged``), instead of raising: a stored run is a result.
+    ``warm_start`` names the run whose final parameters, seed by seed, start this one, and
+    ``warm_start_key`` is that run's :meth:`key`, so that a changed starting run changes this
+    run's key too. ``name`` only labels the run in its group's folder.
+
+    :meth:`definition` writes all of it as one canonical dictionary (:mod:`safepg.definition`),
+    :meth:`from_definition` reads it back, and :meth:`key` hashes it.
     """
 
     name: str
     _: KW_ONLY
     method: Method = field(default_factory=Adaptive)
-    env: str = "lqg1d"
+    task: Any = "lqg1d"
     theta0: tuple[float, ...] = (0.0,)
     sigma: float = 1.0
     budget: int = 30_000_000
+    stop_on_divergence: bool = True
     warm_start: str | None = None
     warm_start_key: str | None = field(default=None, repr=False)
-    env_factory: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.method, Adaptive | Vanilla):
             raise TypeError(f"method must be an Adaptive or a Vanilla, got {self.method!r}")
+        if isinstance(self.task, str):
+            make_env(self.task)  # an unknown name fails here, not in a worker
+        object.__setattr__(self, "theta0", tuple(float(t) for t in np.ravel(self.theta0)))
 
     @property
     def algorithm(self) -> Literal["adaptive", "vanilla"]:
-        """``"adaptive"`` or ``"vanilla"``, the method's name in the records."""
+        """``"adaptive"`` or ``"vanilla"``: which loop runs the method."""
         return "adaptive" if isinstance(self.method, Adaptive) else "vanilla"
 
-    def fields(self) -> dict[str, Any]:
-        """The run's settings as flat named values: what :meth:`key` hashes.
+    def make_task(self) -> Any:
+        """The task this configuration learns on."""
+        return make_env(self.task) if isinstance(self.task, str) else self.task
 
-        The names are those of the records' ``config`` (``estimator``, ``bound``, ``n_min``...),
-        and the values of the options a method does not use are the defaults every key has
-        always held (a vanilla run's key holds ``n_min`` = 100), so that no stored run's key
-        changes. An option set away from the algorithm (``n_first``, ``constants``,
-        ``statistics``, ``step_when_unsafe``, ``update_at_target``) is present only when set.
+    def definition(self, exact: bool = True) -> dict[str, Any]:
+        """Everything that decides the run's numbers, as canonical data (:func:`safepg.definition.to_dict`).
+
+        ``{"task", "method", "theta0", "sigma", "budget", "stop_on_divergence", "warm_start"}``:
+        the task and the method with every field, and for a warm start the key of the run it
+        starts from (else None).
+
+        Raises
+        ------
+        safepg.definition.UnnamedError
+            With ``exact``, a task or function that has no exact definition (a lambda feature map).
+        ValueError
+            ``warm_start`` without ``warm_start_key``.
         """
-        m = self.method
-        error = m.error if isinstance(m, Adaptive) else m.step.error if isinstance(m.step, SafeStep) else ErrorModel()
-        d: dict[str, Any] = dict(
-            algorithm=self.algorithm, env=self.env, theta0=list(self.theta0), sigma=self.sigma,
-            estimator=m.gradient.estimator, baseline=m.gradient.baseline, score_action=m.gradient.score_action,
-            bound=error.bound, delta=error.delta, empirical_range=error.empirical_range,
-            theoretical_range=error.theoretical_range, budget=self.budget,
-        )
-        if isinstance(m, Adaptive):
-            d.update(n_min=m.batches.n_min, n_max=m.batches.n_max, step="scalar")
-            d.update(m.departure_fields())
-        else:
-            d.update(n_min=Batches().n_min, n_max=Batches().n_max, batch_size=m.batch_size, step=m.step.kind,
-                     alpha=m.step.alpha if isinstance(m.step, FixedStep) else None,
-                     target_return=None if m.target is None else m.target.value,
-                     update_at_target=True if m.target is not None and m.target.update else None)
-        if self.warm_start is not None:
-            d["warm_start"] = self.warm_start
-        return {k: v for k, v in d.items() if v is not None}
+        if self.warm_start is not None and self.warm_start_key is None:
+            raise ValueError(f"warm_start_key must be given with warm_start={self.warm_start!r} "
+                             f"(config {self.name!r}): the key of the run it starts from")
+        return run_definition(self.make_task(), self.method, self.theta0, self.sigma, self.budget,
+                              self.stop_on_divergence, self.warm_start_key, exact)
+
+    @classmethod
+    def from_definition(cls, name: str, definition: Mapping[str, Any], warm_start: str | None = None) -> RunConfig:
+        """The configuration :meth:`definition` wrote (``warm_start``: the name of the run it starts from)."""
+        d = dict(definition)
+        return cls(name, method=from_dict(d["method"]), task=from_dict(d["task"]), theta0=tuple(d["theta0"] or (0.0,)),
+                   sigma=d["sigma"], budget=d["budget"], stop_on_divergence=d["stop_on_divergence"],
+                   warm_start=warm_start, warm_start_key=d["warm_start"])
 
     def key(self) -> str:
-        """Hash of everything that determines a run's numbers (not its name)."""
-        d = self.fields()
-        if self.warm_start is not None:  # a changed starting policy must invalidate this run too
-            if self.warm_start_key is None:
-                raise ValueError(f"warm_start_key must be given with warm_start={self.warm_start!r} "
-                                 f"(config {self.name!r}): the key of the run it starts from")
-            d["warm_start"] = [self.warm_start, self.warm_start_key]
-        blob = json.dumps([d, RESULTS_VERSION], sort_keys=True)
+        """Hash of the :meth:`definition` (not of the name) and of :data:`RESULTS_VERSION`."""
+        blob = json.dumps([self.definition(), RESULTS_VERSION], sort_keys=True, allow_nan=False)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
     def seed(self, index: int) -> np.random.SeedSequence:
         """Independent stream for seed ``index`` of this configuration."""
         return np.random.SeedSequence([index, int(self.key(), 16) % 2**63])
-
-    def make_env(self) -> Any:
-        """The task this configuration learns on."""
-        return self.env_factory() if self.env_factory is not None else make_env(self.env)
 
     def run(self, seed: int, progress: bool = False, theta0: np.ndarray | None = None) -> LearningRecord:
         """Run seed ``seed``.
@@ -155,7 +160,7 @@ class RunConfig:
         A warm-started configuration starts from ``theta0``, the final parameters of that
         seed of the run it names; any other starts from its own ``theta0`` field.
         """
-        env = self.make_env()
+        task = self.make_task()
         if self.warm_start is not None:
             if theta0 is None:
                 raise ValueError(f"theta0 must be given for the warm-started config {self.name!r}: "
@@ -165,16 +170,20 @@ class RunConfig:
             raise ValueError(f"theta0 is only for warm-started configs, {self.name!r} starts from {self.theta0}")
         else:
             theta0 = np.asarray(self.theta0, dtype=float)
-        return learn(env, self.method, theta0, self.sigma, budget=self.budget,
-                     rng=np.random.default_rng(self.seed(seed)), progress=progress)
+        rec = learn(task, self.method, theta0, self.sigma, budget=self.budget,
+                    rng=np.random.default_rng(self.seed(seed)), progress=progress,
+                    stop_on_divergence=self.stop_on_divergence)
+        rec.config.update(self.definition(exact=False))  # a warm start's theta0 is its start run's key
+        return rec
 
 
-def run_path(folder: Path, cfg: RunConfig, seed: int) -> Path:
+def run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
     """Where seed ``seed`` of ``cfg`` is stored in a group's folder."""
-    return folder / cfg.name / f"seed-{seed}.npz"
+    return Path(folder) / cfg.name / f"seed-{seed}.npz"
 
 
-def stored_run(folder: Path, cfg: RunConfig, seed: int, on_damaged: OnDamaged = "warn") -> LearningRecord | None:
+def stored_run(folder: str | os.PathLike[str], cfg: RunConfig, seed: int,
+               on_damaged: OnDamaged = "warn") -> LearningRecord | None:
     """Seed ``seed`` of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
 
     A damaged file is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
@@ -182,11 +191,12 @@ def stored_run(folder: Path, cfg: RunConfig, seed: int, on_damaged: OnDamaged = 
     return load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
 
 
-def store_run(rec: LearningRecord, folder: Path, cfg: RunConfig, seed: int) -> None:
+def store_run(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
     """Stamp ``rec`` with the key :func:`stored_run` checks and save it (in the calling process,
     so the stamp is this process's key whatever the worker's copy of the definitions)."""
     rec.config["run_key"] = cfg.key()
     rec.config["config_name"] = cfg.name
+    rec.config["seed"] = seed
     save_atomic(rec, run_path(folder, cfg, seed))
 
 
@@ -205,7 +215,7 @@ def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
     return i, _compute(cfg, seed, theta0, single_thread)
 
 
-def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
+def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
                  on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
     """Finished runs of ``configs`` by config name (missing seeds are left out).
 
@@ -230,7 +240,7 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: Path,
 def run_configs(
     configs: Sequence[RunConfig],
     seeds: int,
-    folder: Path,
+    folder: str | os.PathLike[str],
     starts: Mapping[str, Sequence[np.ndarray]] | None = None,
     jobs: int = -1,
     progress: bool = True,
@@ -263,6 +273,7 @@ def run_configs(
     """
     from joblib import Parallel, delayed, effective_n_jobs
 
+    folder = Path(folder)
     if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
         raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
     starts = starts or {}
@@ -305,3 +316,7 @@ def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
                        "results_version": RESULTS_VERSION})
     with open(folder / TIMING_FILE, "a") as f:
         f.write(line + "\n")
+
+
+__all__ = ["RESULTS_VERSION", "RunConfig", "TIMING_FILE", "load_configs", "make_env", "record_timing", "run_configs",
+           "run_path", "store_run", "stored_run"]

@@ -56,9 +56,10 @@ def prediction_interval95(values: Iterable[float], runs: int = 1) -> dict[str, A
     if int(runs) != runs or runs < 1:
         raise ValueError(f"runs must be a positive integer, got {runs!r}")
     x = np.asarray(list(values), dtype=float)
-    m = float(x.mean()) if x.size else None
     if x.size < 2:
-        return {"mean": m, "pi95": [None, None], "seeds": int(x.size), "runs": int(runs)}
+        return {"mean": float(x.mean()) if x.size else None, "pi95": [None, None], "seeds": int(x.size),
+                "runs": int(runs)}
+    m = float(x.mean())
     h = float(t_quantile_975(x.size - 1) * x.std(ddof=1) * np.sqrt(1 / runs + 1 / x.size))
     return {"mean": m, "pi95": [m - h, m + h], "seeds": int(x.size), "runs": int(runs)}
 
@@ -157,3 +158,6 @@ def t_quantile(df: int, tails: str) -> float:
             else:
                 hi = mid
         return float(mpmath.sqrt(df * (1 - lo) / lo))
+
+
+__all__ = ["mean_ci95", "prediction_band95", "prediction_interval95", "seed_summary95", "t_quantile", "t_quantile_975"]

@@ -181,3 +181,7 @@ def remove_stale_temp_files(folder: Path) -> list[Path]:
         except FileNotFoundError:  # its writer renamed or removed it meanwhile
             continue
     return removed
+
+
+__all__ = ["DAMAGED_SUFFIX", "DamagedRunWarning", "DamagedRunsError", "OnDamaged", "TEMP_MAX_AGE", "TEMP_SUFFIX",
+           "load_stored", "remove_stale_temp_files", "results_dir", "save_atomic", "set_aside"]

@@ -177,7 +177,7 @@ def draw_normals(st: np.ndarray, out: np.ndarray, start: int, rejected: np.ndarr
 
 
 @njit(cache=True)
-def _normal_slow(idx: int, j: np.int64, state: np.uint64) -> tuple[float, np.uint64]:
+def _normal_slow(idx: np.intp, j: np.int64, state: np.uint64) -> tuple[float, np.uint64]:
     """The ziggurat's rare branches for a draw (idx, j) that missed the rectangle test; kept
     out of :func:`next_normal` so that the common path stays a few instructions."""
     while True:
@@ -236,7 +236,8 @@ def trajectory_draws(key: np.uint64, n: int, n_uniform: int, n_normal: int) -> t
     for name, value in (("n_uniform", n_uniform), ("n_normal", n_normal)):
         if int(value) != value or value < 0:
             raise ValueError(f"{name} must be an integer >= 0, got {value}")
-    return _draws(np.uint64(key), int(n), int(n_uniform), int(n_normal))
+    draws: tuple[np.ndarray, np.ndarray] = _draws(np.uint64(key), int(n), int(n_uniform), int(n_normal))
+    return draws
 
 
 @njit(cache=True, parallel=True)

@@ -5,7 +5,7 @@ may also offer fast paths, each a Protocol of one method that the task's class d
 inheriting it:
 
 * :class:`GradientBatch`: a batch's gradient samples and returns in one fused call;
-* :class:`GradientBatchMaxima`: the same and the batch's measured R and M_phi;
+* :class:`GradientBatchConstants`: the same and the batch's measured R and M_phi;
 * :class:`MeasuredReturns`: the per-trajectory performance the loops record as J_hat;
 * :class:`Performance` / :class:`PerformanceBatch`: the closed-form J;
 * :class:`ActionDimension`: the number of action dimensions (else 1).
@@ -20,7 +20,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import numpy as np
 
@@ -42,7 +42,8 @@ class Task(BoundedTask, Protocol):
 class ActionDimension(Protocol):
     """A task whose actions have ``action_dim`` components (the gain has that many rows)."""
 
-    action_dim: int
+    @property
+    def action_dim(self) -> int: ...
 
 
 class GradientBatch(Protocol):
@@ -54,10 +55,10 @@ class GradientBatch(Protocol):
         ...
 
 
-class GradientBatchMaxima(Protocol):
+class GradientBatchConstants(Protocol):
     """:class:`GradientBatch` plus the batch's measured (R, M_phi): its largest |reward| and |feature|."""
 
-    def gradient_batch_maxima(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None,
+    def gradient_batch_constants(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None,
                               estimator: str = "gpomdp", baseline: bool = True, score_action: str = "clipped",
                               ) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
         """Samples, returns and (R, M_phi) of one batch."""
@@ -89,7 +90,7 @@ class PerformanceBatch(Protocol):
 
 
 #: The optional methods, by the Protocol that declares each.
-METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchMaxima: "gradient_batch_maxima",
+METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
                                  MeasuredReturns: "measured_returns", Performance: "performance",
                                  PerformanceBatch: "performance_batch"}
 
@@ -99,7 +100,7 @@ class Hooks:
     """A task's fast paths, bound to the task (None where it has none)."""
 
     gradient_batch: Callable[..., tuple[np.ndarray, np.ndarray]] | None
-    gradient_batch_maxima: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
+    gradient_batch_constants: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
     measured_returns: Callable[[Trajectories], np.ndarray] | None
     performance: Callable[[Any, Any], float] | None
     performance_batch: Callable[[np.ndarray, Any], np.ndarray] | None
@@ -152,11 +153,11 @@ def task_hooks(task: Task) -> Hooks:
             found[name] = getattr(task, name)
     action_dim = 1
     if ActionDimension in cls.__mro__:
-        action_dim = task.action_dim  # type: ignore[attr-defined]
+        action_dim = cast(ActionDimension, task).action_dim  # declared: the class inherits it
         if isinstance(action_dim, bool) or not isinstance(action_dim, int | np.integer) or action_dim < 1:
             raise TypeError(f"{cls.__name__}.action_dim must be an integer >= 1, got {action_dim!r}")
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
 
 
-__all__ = ["ActionDimension", "GradientBatch", "GradientBatchMaxima", "Hooks", "MeasuredReturns", "Performance",
-           "PerformanceBatch", "Task", "task_hooks"]
+__all__ = ["METHOD_HOOKS", "ActionDimension", "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns",
+           "Performance", "PerformanceBatch", "Task", "task_hooks"]

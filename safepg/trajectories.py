@@ -52,4 +52,8 @@ class Trajectories:
 
     def discounted_returns(self) -> np.ndarray:
         """Per-trajectory discounted return sum_t gamma^t r_t, shape (N,)."""
-        return np.sum(self.rewards * self.discounts(), axis=1)  # not BLAS (safepg.portable)
+        returns: np.ndarray = np.sum(self.rewards * self.discounts(), axis=1)  # not BLAS (safepg.portable)
+        return returns
+
+
+__all__ = ["Trajectories"]

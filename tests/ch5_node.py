@@ -10,6 +10,7 @@ import subprocess
 from typing import Any
 
 from safepg.thesis.explorers.component import static_text
+from safepg.thesis.explorers.js_tasks import learner_sources
 
 NODE = shutil.which("node")
 #: Control moves that each change what the Chapter 5 explorers draw, in the page
@@ -26,9 +27,12 @@ CH5_MOVES: dict[str, list[tuple[str, Any]]] = {
 _SCRIPT = r"""
 const src = require("fs").readFileSync(0, "utf8");
 const req = JSON.parse(src);
-const [page, linked] = new Function(req.src + "\nreturn [" + req.object + ", safepgCh5Linked];")();
+const [page, linked, learner] = new Function(
+  req.src + "\nreturn [" + req.object + ", safepgCh5Linked, safepgLearner];")();
 const out = req.cases.map(c => ({
   configs: c.configs ? page.configs(c.p, c.data) : null,
+  // each run's configuration as the learner completes it (the option table's defaults filled in)
+  completed: c.configs ? page.configs(c.p, c.data).runs.map(r => learner.runOptions(r.cfg)) : null,
   result: c.traces ? page.result(c.p, {runs: c.traces}, c.data) : null,
   linked: c.linked ? linked(c.links, c.linked[0], c.linked[1]) : null}));
 process.stdout.write(JSON.stringify(out));
@@ -36,9 +40,10 @@ process.stdout.write(JSON.stringify(out));
 
 
 def run_page(script: str, obj: str, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces"}``, or
+    """``obj`` (a page object of ``script``) on each case: ``{"p", "data", "configs": bool, "traces"}`` (with
+    ``configs``, the answer's ``completed`` holds each run's configuration as the learner completes it), or
     ``{"links", "linked": [name, value]}`` for the page's answer to a control's move (``safepgCh5Linked``)."""
-    src = static_text("live_jobs.js") + "\n" + static_text("ch5_page.js") + "\n" + static_text(script)
+    src = "\n".join([learner_sources(), static_text("live_jobs.js"), static_text("ch5_page.js"), static_text(script)])
     proc = subprocess.run([NODE, "-e", _SCRIPT], input=json.dumps({"src": src, "object": obj, "cases": cases}),
                           capture_output=True, text=True, timeout=120, check=False)
     if proc.returncode:

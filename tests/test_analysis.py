@@ -3,14 +3,15 @@
 import numpy as np
 import pytest
 
+from safepg.definition import to_dict
 from safepg.learning import LearningRecord
+from safepg.options import Adaptive, ErrorModel, FixedStep, Vanilla
+from safepg.record import on_trajectories
 from safepg.thesis.analysis import (
     by_iteration,
     markdown_table,
     mean_band,
-    measured_on_grid,
     one_cell_spread,
-    performance_on_grid,
     table_5_2,
     table_upsilon,
 )
@@ -22,9 +23,9 @@ def rec(batch, J):
                           np.array(J[:-1]) + 1, np.zeros((I, 1)), np.zeros(I), np.ones(I, bool))
 
 
-def test_performance_on_grid_holds_each_J_for_its_batch():
+def test_on_trajectories_holds_each_J_for_its_batch():
     r = rec([10, 20, 5], [-5.0, -4.0, -3.0, -2.5])
-    got = performance_on_grid([r], np.array([1, 10, 11, 30, 31, 35, 36]))[0]
+    got = on_trajectories([r], np.array([1, 10, 11, 30, 31, 35, 36]))[0]
     np.testing.assert_array_equal(got, [-5, -5, -4, -4, -3, -3, np.nan])
 
 
@@ -38,10 +39,11 @@ def test_by_iteration_and_band():
 
 
 def test_table_5_2_differences():
-    report = {"configs": [{"estimator": "gpomdp", "bound": "bernstein", "empirical_range": True, "delta": 0.95,
-                           "seeds": 5, "upsilon_bar": {"mean": -9.7, "ci95": [-9.8, -9.6]},
+    method = to_dict(Adaptive(error=ErrorModel("bernstein", 0.95, "empirical")))
+    report = {"configs": [{"method": method, "seeds": 5, "upsilon_bar": {"mean": -9.7, "ci95": [-9.8, -9.6]},
                            "improvement_ratio": {"mean": 1.0}, "thesis": {"upsilon_bar": -9.6623, "ci95": [1, 2]}}]}
     row = table_5_2(report)[0]
+    assert (row["estimator"], row["bound"], row["empirical_range"], row["delta"]) == ("gpomdp", "bernstein", True, 0.95)
     assert abs(row["difference"] - (-9.7 + 9.6623)) < 1e-12
     md = markdown_table([row], [("ours", "ours", ".3f"), ("ci95", "CI", ".1f"), ("missing", "x", "")])
     assert md.splitlines()[2] == "| -9.700 | [-9.8; -9.6] | - |"
@@ -89,25 +91,26 @@ def test_simulated_objective_optimum_differs_from_closed_form():
     assert -0.70 < best < -0.60 and abs(f(best) - (-9.56)) < 0.05
 
 
-def test_measured_on_grid_holds_each_batch_average():
+def test_on_trajectories_holds_each_batch_average():
     r = rec([10, 20], [-5.0, -4.0, -3.0])  # J_hat = J[:-1] + 1
-    got = measured_on_grid([r], np.array([1, 10, 11, 30, 31]))[0]
+    got = on_trajectories([r], np.array([1, 10, 11, 30, 31]), "J_hat")[0]
     np.testing.assert_array_equal(got, [-4, -4, -3, -3, np.nan])
 
 
 def test_table_upsilon_differences():
     report = {"configs": [
-        {"name": "adaptive", "batch_size": None, "alpha": None, "seeds": 5,
+        {"name": "adaptive", "method": to_dict(Adaptive()), "seeds": 5,
          "upsilon_bar": {"mean": 184.2, "ci95": [183.0, 185.4]},
          "improvement_ratio": {"mean": 0.55, "ci95": [0.5, 0.6]},
          "thesis": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301}},
-        {"name": "extra", "batch_size": 10, "alpha": 0.1, "seeds": 1,
+        {"name": "extra", "method": to_dict(Vanilla(10, FixedStep(0.1))), "seeds": 1,
          "upsilon_bar": {"mean": 1.0, "ci95": [1.0, 1.0]}, "improvement_ratio": {"mean": 1.0, "ci95": [1, 1]},
          "thesis": None}]}
     a, extra = table_upsilon(report)
     assert a["upsilon_difference"] == pytest.approx(184.2 - 193.12)
     assert a["improvement_difference"] == pytest.approx(0.55 - 0.5301)
     assert a["batch_size"] is None and extra["thesis_upsilon_bar"] is None and extra["upsilon_difference"] is None
+    assert (extra["batch_size"], extra["alpha"]) == (10, 0.1)
 
 
 def test_comparison_figures_draw_the_seed_means():

@@ -21,18 +21,17 @@ from types import ModuleType
 
 import pytest
 import yaml
+from script_module import load
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "book" / "api.md"
 #: The modules the reference must cover; others (safepg.options, safepg.tasks) may be added.
-REQUIRED = ["safepg", "safepg.options", "safepg.tasks", "safepg.envs", "safepg.runner", "safepg.store"]
+REQUIRED = ["safepg", "safepg.options", "safepg.tasks", "safepg.envs", "safepg.definition", "safepg.runner",
+            "safepg.record", "safepg.store"]
 
 
 def _listing() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("api_listing", ROOT / "book" / "_ext" / "api_listing.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load("book/_ext/api_listing.py")
 
 
 listing = _listing()
@@ -40,28 +39,22 @@ TEXT = PAGE.read_text(encoding="utf-8")
 MODULES = listing.block_modules(TEXT)
 
 
-def expected_names(modname: str) -> set[str]:
-    """Public names of a module, found without the extension: ``__all__``, else what it defines.
-
-    Parameters
-    ----------
-    modname : str
-        Dotted module name.
-
-    Returns
-    -------
-    set of str
-        ``__all__``, or the public classes and functions whose ``__module__`` is the module
-        and the public names its own ``#:`` comments document.
-    """
+def defined_names(modname: str) -> set[str]:
+    """Public names a module defines, found without its ``__all__``: the public classes and
+    functions whose ``__module__`` is the module, and the names its own ``#:`` comments document."""
     module = importlib.import_module(modname)
-    if hasattr(module, "__all__"):
-        return set(module.__all__)
     names = {n for n, obj in vars(module).items()
              if not n.startswith("_") and getattr(obj, "__module__", None) == modname}
     source = inspect.getsource(module)
     names |= {n for n in re.findall(r"^#:.*\n(?:#:.*\n)*([A-Za-z]\w*)\s*[:=]", source, re.MULTILINE)}
     return names
+
+
+def expected_names(modname: str) -> set[str]:
+    """The names a module exports: its ``__all__``, which every listed module must have."""
+    module = importlib.import_module(modname)
+    assert hasattr(module, "__all__"), f"{modname} has no __all__"
+    return set(module.__all__)
 
 
 def documented(expanded: str, full_only: bool = False) -> dict[str, set[str]]:
@@ -97,6 +90,13 @@ def test_every_public_name_has_an_entry(modname: str) -> None:
     assert not want - have, f"{modname}: no entry in the API reference for {sorted(want - have)}"
     extra = have - set(listing.public_names(modname))
     assert not extra, f"{modname}: entries for names that are not public: {sorted(extra)}"
+
+
+@pytest.mark.parametrize("modname", [m for m in MODULES if m not in ("safepg", "safepg.envs")])
+def test_each_module_exports_what_it_defines(modname: str) -> None:
+    """A public class, function or documented value a module defines is in its ``__all__``."""
+    missing = defined_names(modname) - expected_names(modname)
+    assert not missing, f"{modname}.__all__ leaves out {sorted(missing)}"
 
 
 def test_safepg_all_is_covered() -> None:

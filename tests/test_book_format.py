@@ -3,7 +3,6 @@ figure axes. The browser test (test_browser_book.py) checks the built pages."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -13,6 +12,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import sympy as sp  # noqa: E402
+from script_module import load
 
 from safepg.thesis.analysis import errata_markdown, markdown_table, with_labels  # noqa: E402
 
@@ -20,10 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _thesis_numbers():
-    spec = importlib.util.spec_from_file_location("thesis_numbers", ROOT / "book" / "_ext" / "thesis_numbers.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load("book/_ext/thesis_numbers.py")
 
 
 def test_markdown_table_plain_and_captioned():

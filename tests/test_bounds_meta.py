@@ -187,3 +187,12 @@ def test_theoretical_range_override():
     for bad in (-1.0, 0.0, float("nan"), float("inf"), "foo", True):
         with pytest.raises(ValueError, match="^range"):
             error_bound("hoeffding", x, 0.5, K1, range=bad)
+
+
+def test_a_zero_gradient_needs_n_max_for_the_batch_size():
+    """With g = 0 no batch makes the step safe: N* is infinite, and the batch size is N_max."""
+    bound = ErrorBound(2.0, 0.0)
+    assert n_star_closed_form(0.0, bound) == math.inf
+    assert optimal_batch_size(0.0, bound, 1.0, n_min=10, n_max=5000) == 5000
+    with pytest.raises(ValueError, match="^n_max must be given"):
+        optimal_batch_size(0.0, bound, 1.0, n_min=10)

@@ -42,12 +42,13 @@ from test_learner2d_js import (
 
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole, step_dynamics
-from safepg.learning import adaptive_pg, vanilla_pg
-from safepg.options import Batches, Departures, ErrorModel, FixedStep
+from safepg.learning import learn
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.thesis.authors import cartpole_theta_star
 from safepg.thesis.experiments import AUTHORS_DOUBLED
 from safepg.thesis.explorers.js_tasks import cartpole_task_data
+from safepg.thesis.explorers.option_names import learner_options
 
 AUTHORS = CartPole.thesis_doubled(**AUTHORS_DOUBLED)  # 2 m pole, m l = 0.05, 12 deg, gamma 1 (0.9 in c)
 THESIS = CartPole.thesis_doubled()
@@ -86,11 +87,11 @@ def test_gradient_samples_match_the_kernel(task, estimator, baseline, score, tmp
     n, seed, sigma = 1500, 21, 1.0
     theta = THETA_STAR if task.pole_length == 2 else np.array([0.2, 0.8, 12.0, 3.0])
     policy = LinearGaussianPolicy(theta.reshape(1, 4), sigma)
-    samples, lengths, found = task.gradient_batch_maxima(policy, n, np.random.default_rng(seed), estimator, baseline,
+    samples, lengths, found = task.gradient_batch_constants(policy, n, np.random.default_rng(seed), estimator, baseline,
                                                           score)
     U, Z = replay_draws(seed, [n], 4, task.horizon)
     q = {"task": cartpole_task_data(task), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": 4,
-         "H": task.horizon, "opt": {"estimator": estimator, "baseline": baseline, "score": score},
+         "H": task.horizon, "opt": {"estimator": estimator, "baseline": baseline, "scoreAction": score},
          "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}
     js = run_node({"batch": [q]})["batch"][0]
     assert js["returns"] == lengths.tolist()
@@ -110,18 +111,15 @@ def test_bounds_and_steps_under_every_option(tmp_path):
 def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     seed, budget, task = 6, 9000, AUTHORS
+    method: Adaptive | Vanilla
     if kind == "adaptive-authors":
-        py = adaptive_pg(task, THETA_STAR, 1.0, budget=budget, rng=seed, **_ADAPTIVE_AUTHORS)
-        cfg = {"bound": "bernstein", "empiricalRange": True, "nFirst": 1000, "nMin": 10, "constants": "batch",
-               "statistics": "max", "stepWhenUnsafe": True}
+        method = Adaptive(**_ADAPTIVE_AUTHORS)
     elif kind == "coordinate-authors":
-        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, step=FixedStep(0.01, "coordinate"), budget=budget,
-                        rng=seed)
-        cfg = {"algorithm": "vanilla", "batchSize": 1000, "alpha": 0.01, "step": "coordinate"}
+        method = Vanilla(1000, FixedStep(0.01, "coordinate"))
     else:
-        task = THESIS
-        py = vanilla_pg(task, THETA_STAR, 1.0, batch_size=1000, step=FixedStep(1e-3), budget=budget, rng=seed)
-        cfg = {"algorithm": "vanilla", "batchSize": 1000, "alpha": 1e-3}
+        task, method = THESIS, Vanilla(1000, FixedStep(1e-3))
+    py = learn(task, method, THETA_STAR, 1.0, budget=budget, rng=seed)
+    cfg = learner_options(method)  # the page's configuration of the same method
     U, Z = replay_draws(seed, py.batch_size, 4, task.horizon)
     js = run_node({"replay": {"cfg": {**cfg, "budget": budget, "theta0": THETA_STAR.tolist()},
                               "task": cartpole_task_data(task), "H": task.horizon,
@@ -138,32 +136,22 @@ def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
 SEEDS = 30
 _ADAPTIVE_AUTHORS = dict(error=ErrorModel("bernstein", range="empirical"), batches=Batches(n_min=10, first=1000),
                          departures=Departures(batch_constants=True, maxima=True, unguarded_step=True))
-#: name -> (task, safepg call, the JavaScript cfg); budgets of a few thousand episodes.
-SETTINGS: dict[str, tuple[CartPole, Any, dict[str, Any]]] = {
-    "authors' adaptive (Table 5.4), 5000": (
-        AUTHORS, lambda s: adaptive_pg(AUTHORS, THETA_STAR, 1.0, budget=5000, rng=s, **_ADAPTIVE_AUTHORS),
-        {"bound": "bernstein", "empiricalRange": True, "nFirst": 1000, "nMin": 10, "constants": "batch",
-         "statistics": "max", "stepWhenUnsafe": True, "budget": 5000}),
-    "authors' N = 1000, coordinate alpha = 0.01, 5000": (
-        AUTHORS, lambda s: vanilla_pg(AUTHORS, THETA_STAR, 1.0, batch_size=1000,
-                                      step=FixedStep(0.01, "coordinate"), budget=5000, rng=s),
-        {"algorithm": "vanilla", "batchSize": 1000, "alpha": 0.01, "step": "coordinate", "budget": 5000}),
-    "thesis task, N = 500, scalar alpha = 0.01, 4000": (
-        THESIS, lambda s: vanilla_pg(THESIS, THETA_STAR, 1.0, batch_size=500, step=FixedStep(0.01), budget=4000, rng=s),
-        {"algorithm": "vanilla", "batchSize": 500, "alpha": 0.01, "budget": 4000}),
-    "thesis text's adaptive (theta frozen), 3000": (
-        THESIS, lambda s: adaptive_pg(THESIS, THETA_STAR, 1.0, error=ErrorModel("bernstein", range="empirical"),
-                                      budget=3000, rng=s),
-        {"bound": "bernstein", "empiricalRange": True, "budget": 3000}),
+#: name -> (task, method, budget): a few thousand episodes each.
+SETTINGS: dict[str, tuple[CartPole, Adaptive | Vanilla, int]] = {
+    "authors' adaptive (Table 5.4), 5000": (AUTHORS, Adaptive(**_ADAPTIVE_AUTHORS), 5000),
+    "authors' N = 1000, coordinate alpha = 0.01, 5000": (AUTHORS, Vanilla(1000, FixedStep(0.01, "coordinate")), 5000),
+    "thesis task, N = 500, scalar alpha = 0.01, 4000": (THESIS, Vanilla(500, FixedStep(0.01)), 4000),
+    "thesis text's adaptive (theta frozen), 3000": (THESIS, Adaptive(error=ErrorModel("bernstein", range="empirical")),
+                                                    3000),
 }
 
 
 def agreement(name: str, seeds: int = SEEDS) -> tuple[list[dict[str, Any]], list[bool], list[bool]]:
-    task, call, cfg = SETTINGS[name]
+    task, method, budget = SETTINGS[name]
     data = cartpole_task_data(task)
-    js = run_node({"seeds": [{"task": data, "cfg": {**cfg, "theta0": THETA_STAR.tolist(), "seed": k}}
-                             for k in range(seeds)]})["seeds"]
-    py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
+    cfg = {**learner_options(method), "budget": budget, "theta0": THETA_STAR.tolist()}
+    js = run_node({"seeds": [{"task": data, "cfg": {**cfg, "seed": k}} for k in range(seeds)]})["seeds"]
+    py = one_thread(lambda: [learn(task, method, THETA_STAR, 1.0, budget=budget, rng=1000 + k) for k in range(seeds)])
     values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
               "L1 distance theta_final - theta*": ([np.abs(np.array(s["theta_final"]) - THETA_STAR).sum() for s in js],
                                            [np.abs(r.theta[-1] - THETA_STAR).sum() for r in py]),

@@ -234,7 +234,7 @@ def _reference_peak(task: CartPole, pol: LinearGaussianPolicy, n: int, seed: int
 def test_batch_maxima_are_the_largest_reward_and_feature(case: str) -> None:
     task, K, sig = CASES[case]
     pol = LinearGaussianPolicy(K, sig)
-    samples, returns, (R, M_phi) = task.gradient_batch_maxima(pol, N, 5)
+    samples, returns, (R, M_phi) = task.gradient_batch_constants(pol, N, 5)
     plain = task.gradient_batch(pol, N, 5)
     assert np.array_equal(samples, plain[0]) and np.array_equal(returns, plain[1])  # the same batch
     assert R == 1.0
@@ -244,5 +244,5 @@ def test_batch_maxima_are_the_largest_reward_and_feature(case: str) -> None:
 
     scaled = CartPole(feature_scale=NORMALISED_SCALE, feature_bound=1.0)
     pol_scaled = LinearGaussianPolicy(K * np.asarray(NORMALISED_SCALE), sig)  # the same policy in those units
-    assert scaled.gradient_batch_maxima(pol_scaled, 300, 5)[2][1] == pytest.approx(
+    assert scaled.gradient_batch_constants(pol_scaled, 300, 5)[2][1] == pytest.approx(
         _reference_peak(scaled, pol_scaled, 300, 5), rel=1e-12)

@@ -27,17 +27,18 @@ from safepg.thesis.explorers.cartpole_learner import (
     vanilla_method,
 )
 from safepg.thesis.explorers.ch5_live import record_c, record_trace
-from safepg.thesis.explorers.js_tasks import cartpole_task_data, learner_options
+from safepg.thesis.explorers.js_tasks import cartpole_task_data
+from safepg.thesis.explorers.option_names import learner_options
 
 needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
 BOXES = [name for name, *_ in SETTINGS]
 #: Each box: the CartPole fields and the options of Algorithm 4.1 it sets (under the page learner's
-#: names, js_tasks.learner_options), and nothing else.
+#: names, option_names.learner_options), and nothing else.
 EXPECTED = {"gamma09": ({"gamma": 1.0, "constants_gamma": 0.9}, {}),
-            "batch_constants": ({}, {"constants": "batch"}),
-            "max_stats": ({}, {"statistics": "max"}),
-            "unguarded": ({}, {"stepWhenUnsafe": True}),
-            "first1000": ({}, {"nFirst": 1000, "nMin": 10}),
+            "batch_constants": ({}, {"batchConstants": True}),
+            "max_stats": ({}, {"maxima": True}),
+            "unguarded": ({}, {"unguardedStep": True}),
+            "first1000": ({}, {"first": 1000, "nMin": 10}),
             "deg12": ({"angle_threshold_deg": 12.0}, {}),
             "ml005": ({"polemass_length": 0.05}, {})}
 
@@ -64,13 +65,13 @@ def test_no_box_is_table_5_4_and_every_box_is_table_5_4_authors(explorer):
     p0 = explorer.defaults()
     thesis = get_experiment("table-5.4").config("adaptive")
     assert adaptive_method(p0) == thesis.method
-    assert cartpole_task(p0).setting_name() == thesis.env == "cartpole-doubled"
+    assert cartpole_task(p0).setting_name() == thesis.task == "cartpole-doubled"
     authors = get_experiment("table-5.4-authors-theta-star").config("adaptive")
     p1 = {**p0, **{b: True for b in BOXES}}
     method = adaptive_method(p1)
     assert (method.error, method.batches, method.departures) == (
         authors.method.error, authors.method.batches, authors.method.departures)
-    assert cartpole_task(p1).setting_name() == authors.env
+    assert cartpole_task(p1).setting_name() == authors.task
     assert explorer.data["starts"]["theta_star"] == list(authors.theta0) == cartpole_theta_star().tolist()
     van = get_experiment("table-5.4").config("N=4000")
     assert vanilla_method() == van.method  # the fixed-step method is table-5.4's, whatever the boxes
@@ -100,16 +101,15 @@ def test_page_sends_the_engine_the_twins_settings(explorer):
     for m, got in zip(moves, out):
         p = {**p0, **m}
         runs = {r["name"]: r["cfg"] for r in got["configs"]["runs"]}
+        completed = {r["name"]: c for r, c in zip(got["configs"]["runs"], got["completed"])}
         assert got["configs"]["task"] == cartpole_task_data(cartpole_task(p))
         for name, method in (("adaptive", adaptive_method(p)), ("vanilla", vanilla_method())):
             cfg = runs[name]
-            assert cfg["algorithm"] == name and cfg["sigma"] == p["sigma"] and cfg["seed"] == round(p["seed"])
+            assert cfg["sigma"] == p["sigma"] and cfg["seed"] == round(p["seed"])
             assert cfg["theta0"] == explorer.data["starts"][p["start"]] and cfg["budget"] == int(p["budget"])
-            for k, v in learner_options(method).items():
-                if k not in cfg:  # the page leaves out what is at the learner's default
-                    assert (k, v) == ("theoreticalRange", None), (m, name, k)
-                elif not (name == "vanilla" and k in ("bound", "empiricalRange", "delta")):  # no bound in a fixed step
-                    assert cfg[k] == v, (m, name, k)
+            # The page's configuration, completed as the learner completes it, is the method's own.
+            options = learner_options(method)
+            assert {k: completed[name][k] for k in options} == options, (m, name)
             if name == "vanilla":
                 assert cfg["stopOnDivergence"] is True  # learn() stops a diverging vanilla run
 

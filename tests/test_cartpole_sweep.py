@@ -188,7 +188,7 @@ def test_sweep_experiments_are_well_formed() -> None:
         base = get_experiment(st.baseline_experiment)
         assert len(base.configs) == 1 and base.configs[0].method.target.value == 195.0
         if st.task and st.warm_start is None:  # its own baseline, on its own 1 m task
-            assert make_env(base.configs[0].env) == CartPole.thesis(**st.task)
+            assert make_env(base.configs[0].task) == CartPole.thesis(**st.task)
         if not st.doubled:
             assert f"{st.key}:adaptive" not in names
             continue
@@ -196,14 +196,14 @@ def test_sweep_experiments_are_well_formed() -> None:
         assert (ad.algorithm, ad.method.error, ad.budget) == ("adaptive", ErrorModel("bernstein", 0.95, "empirical"),
                                                               SWEEP_BUDGET)
         assert ad.warm_start == st.baseline_experiment
-        assert make_env(ad.env) == CartPole.thesis_doubled(**st.task, **st.constants)
+        assert make_env(ad.task) == CartPole.thesis_doubled(**st.task, **st.constants)
         # The bound constants alone do not change the vanilla run: shared with the default's.
         van = f"{st.key}:N=4000"
         assert (van in names) == (not st.constants or bool(st.task))
         if van in names:
             v = exp.config(van)
             assert (v.method.batch_size, v.method.step, v.warm_start) == (4000, FixedStep(0.01), st.baseline_experiment)
-            assert make_env(v.env) == CartPole.thesis_doubled(**st.task)
+            assert make_env(v.task) == CartPole.thesis_doubled(**st.task)
     assert "cartpole-sweep" in EXPERIMENTS and "thesis:N=4000" in names
 
 

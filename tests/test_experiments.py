@@ -1,7 +1,6 @@
 """Experiment runner: definitions, resume, invalidation, report, CLI."""
 
 import json
-from collections import defaultdict
 from dataclasses import replace
 
 import numpy as np
@@ -9,7 +8,7 @@ import pytest
 
 from safepg import runner, stats, store
 from safepg.cli import main
-from safepg.options import Departures, FixedStep
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep
 from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
 from safepg.thesis import report as rp
@@ -21,9 +20,9 @@ def root(tmp_path, monkeypatch):
     return tmp_path
 
 
-def flat(c):
-    """A config's settings under their flat names (RunConfig.fields()), None where unset."""
-    return defaultdict(lambda: None, c.fields())
+def fixed(c):
+    """(batch size, step size) of a fixed-step config."""
+    return c.method.batch_size, c.method.step.alpha
 
 
 def small(name="table-5.2", configs=3, budget=3000, seeds=2):
@@ -98,10 +97,11 @@ def test_report_structure(root):
     rep = rp.report(exp, es.run_experiment(exp, jobs=1, progress=False))
     assert rep["experiment"] == "table-5.2" and len(rep["configs"]) == 2
     row = rep["configs"][0]
-    for key in ("name", "estimator", "bound", "empirical_range", "delta", "sigma", "seeds",
-                "upsilon_bar", "improvement_ratio", "J_at", "J_final", "thesis"):
+    for key in ("name", "method", "sigma", "budget", "seeds", "upsilon_bar", "improvement_ratio", "J_at", "J_final",
+                "thesis"):
         assert key in row
-    assert row["seeds"] == 3 and row["estimator"] == "reinforce" and row["bound"] == "chebyshev"
+    assert row["seeds"] == 3 and row["method"]["gradient"]["estimator"] == "reinforce"
+    assert row["method"]["error"]["bound"] == "chebyshev"
     lo, hi = row["upsilon_bar"]["ci95"]
     assert lo <= row["upsilon_bar"]["mean"] <= hi
     assert list(row["J_at"]) == ["100000"]
@@ -120,13 +120,17 @@ def test_cli_list_run_report(root, capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "table-5.1" in out and "table-5.2" in out
+    assert main(["list", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)["table-5.3"]["configs"]["adaptive"]
+    cfg = ex.get_experiment("table-5.3").config("adaptive")
+    assert listed == {"key": cfg.key(), "definition": cfg.definition()}
     assert main(["run", "table-5.1", "--seeds", "1", "--budget", "20000", "--jobs", "2", "--quiet"]) == 0
     capsys.readouterr()
     assert main(["report", "table-5.1", "--seeds", "1", "--budget", "20000", "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert rep["experiment"] == "table-5.1" and len(rep["configs"]) == 24
     row = rep["configs"][0]
-    assert row["batch_size"] == 10_000 and row["alpha"] == 1e-3 and row["seeds"] == 1
+    assert row["method"]["batch_size"] == 10_000 and row["method"]["step"]["alpha"] == 1e-3 and row["seeds"] == 1
     assert row["thesis"] == {"improvement_ratio": 0.9596}
 
 
@@ -138,20 +142,19 @@ def test_unknown_experiment():
 def test_sections_5_2_and_5_3_definitions():
     f55, t53 = ex.get_experiment("figures-5.5-5.6"), ex.get_experiment("table-5.3")
     for c in f55.configs + t53.configs:
-        assert c.env == "lqg2d-gamma0.9" and c.theta0 == (0.0,) * 4 and c.budget == 30_000_000
-    assert {flat(c)["step"] for c in f55.configs} == {"scalar", "coordinate"}
-    assert all(flat(c)["batch_size"] == 2000 and flat(c)["alpha"] is None and flat(c)["bound"] == "chebyshev"
-               and flat(c)["delta"] == 0.95 for c in f55.configs)
-    adaptive, n1000, n100 = (flat(c) for c in t53.configs)
-    assert (adaptive["algorithm"], adaptive["bound"], adaptive["empirical_range"]) == ("adaptive", "bernstein", True)
-    assert (n1000["batch_size"], n1000["alpha"], n100["batch_size"], n100["alpha"]) == (1000, 1e-6, 100, 1e-6)
+        assert c.task == ex.make_env("lqg2d-gamma0.9") and c.theta0 == (0.0,) * 4 and c.budget == 30_000_000
+    assert {c.method.step.kind for c in f55.configs} == {"scalar", "coordinate"}
+    assert all(c.method.batch_size == 2000 and c.method.step.error == ErrorModel("chebyshev", 0.95)
+               for c in f55.configs)
+    adaptive, n1000, n100 = t53.configs
+    assert adaptive.method == Adaptive(error=ErrorModel("bernstein", 0.95, "empirical"))
+    assert (fixed(n1000), fixed(n100)) == ((1000, 1e-6), (100, 1e-6))
     env = ex.make_env("lqg2d-gamma0.9")
     assert env.dim == 2 and env.gamma == 0.9 and ex.make_env("lqg2d").gamma == 0.95
     base, t54 = ex.get_experiment("cartpole-baseline"), ex.get_experiment("table-5.4")
     (b,) = base.configs
-    assert (b.env, flat(b)["batch_size"], flat(b)["alpha"], flat(b)["target_return"]) == ("cartpole", 4000, 0.01,
-                                                                                         195.0)
-    assert {c.env for c in t54.configs} == {"cartpole-doubled"} and len({c.budget for c in t54.configs}) == 1
+    assert (b.task, *fixed(b), b.method.target.value) == ("cartpole", 4000, 0.01, 195.0)
+    assert {c.task for c in t54.configs} == {"cartpole-doubled"} and len({c.budget for c in t54.configs}) == 1
     assert all(c.warm_start == "cartpole-baseline" for c in t54.configs)
     assert base.performance == t54.performance == "J_hat" and t53.performance == "J"
     assert ex.make_env("cartpole-doubled").pole_length == 2 * ex.make_env("cartpole").pole_length
@@ -186,8 +189,8 @@ def test_warm_start_runs_the_baseline_first_and_starts_from_it(root):
         mod.EXPERIMENTS.update(saved)
     rep = rp.report(t54, recs)
     rows = {r["name"]: r for r in rep["configs"]}
-    assert rows["adaptive"]["batch_size"] is None and rows["adaptive"]["alpha"] is None
-    assert (rows["N=4000"]["batch_size"], rows["N=4000"]["alpha"]) == (4000, 0.01)
+    assert rows["adaptive"]["method"]["type"] == "Adaptive"
+    assert (rows["N=4000"]["method"]["batch_size"], rows["N=4000"]["method"]["step"]["alpha"]) == (4000, 0.01)
     for name, row in rows.items():
         assert row["improvement_ratio_on"] == "J_hat" and row["J_final"] is None and row["J_at"] == {}
         expected = np.mean([r.improvement_ratio("J_hat") for r in recs[name]])
@@ -215,19 +218,17 @@ def test_authors_experiments_are_the_library_settings_combined():
     assert t51.rules == "authors" and all(c.theta0 == (-0.575853,) for c in t51.configs)
     assert [replace(c, theta0=(-0.575,)) for c in t51.configs] == list(ex.get_experiment("table-5.1").configs)
     base = ex.get_experiment("cartpole-baseline-authors").configs[0]
-    assert ex.make_env(base.env) == CartPole(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9)
-    fb = flat(base)
-    assert fb["update_at_target"] and (fb["batch_size"], fb["alpha"], fb["step"], fb["target_return"]) == (
+    assert ex.make_env(base.task) == CartPole(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9)
+    assert base.method.target.update and (*fixed(base), base.method.step.kind, base.method.target.value) == (
         4000, 0.01, "scalar", 195.0)
     t54 = ex.get_experiment("table-5.4-authors")
     ad, fx = t54.config("adaptive"), t54.config("N=4000")
-    assert ex.make_env(ad.env) == CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9,
-                                                          polemass_length=0.05) == ex.make_env(fx.env)
-    fa, ff = flat(ad), flat(fx)
-    assert (fa["n_first"], fa["n_min"], fa["n_max"], fa["constants"], fa["statistics"], fa["step_when_unsafe"]) == (
-        1000, 10, 500_000, "batch", "max", True)
-    assert (fa["bound"], fa["empirical_range"], fa["delta"]) == ("bernstein", True, 0.95)
-    assert (ff["step"], ff["alpha"], ff["batch_size"]) == ("coordinate", 0.01, 4000)
+    assert ex.make_env(ad.task) == CartPole.thesis_doubled(angle_threshold_deg=12.0, gamma=1.0, constants_gamma=0.9,
+                                                           polemass_length=0.05) == ex.make_env(fx.task)
+    assert ad.method.batches == Batches(10, 500_000, 1000)
+    assert ad.method.departures == Departures(batch_constants=True, maxima=True, unguarded_step=True)
+    assert ad.method.error == ErrorModel("bernstein", 0.95, "empirical")
+    assert (fx.method.step.kind, *fixed(fx)[::-1]) == ("coordinate", 0.01, 4000)
     assert ad.budget == fx.budget == TABLE_5_4_BUDGET and t54.rules == "authors" and t54.thesis == ex.get_experiment(
         "table-5.4").thesis
     assert ad.warm_start == "cartpole-baseline-authors" and ad.warm_start_key == base.key()
@@ -241,7 +242,7 @@ def test_authors_experiments_are_the_library_settings_combined():
     assert [c.name for c in t52a.configs] == ["gpomdp-hoeffding-delta=0.95", "gpomdp-bernstein-delta=0.95"]
     assert [replace(c, method=replace(c.method, departures=Departures())) for c in t52a.configs] == [
         t52.config(c.name) for c in t52a.configs]
-    assert all(flat(c)["step_when_unsafe"] and flat(c)["theoretical_range"] == 1280.0 for c in t52a.configs)
+    assert all(c.method.departures.unguarded_step and c.method.error.range == 1280.0 for c in t52a.configs)
     assert t52a.rules == "authors" and t52a.thesis == {c.name: t52.thesis[c.name] for c in t52a.configs}
 
 
@@ -251,7 +252,8 @@ def test_authors_experiment_runs_and_is_counted_their_way(root):
     exp = ex.scaled(ex.get_experiment("table-5.4-authors-theta-star"), seeds=1, budget=12_000)
     recs = es.run_experiment(exp, jobs=1, progress=False)
     ad, fx = recs["adaptive"][0], recs["N=4000"][0]
-    assert ad.batch_size[0] == 1000 and ad.config["constants"] == "batch" and fx.batch_size[0] == 4000
+    assert ad.batch_size[0] == 1000 and fx.batch_size[0] == 4000
+    assert ad.config["method"]["departures"]["batch_constants"]
     assert np.all(np.count_nonzero(np.diff(fx.theta, axis=0), axis=1) <= 1)  # one component per update
     assert 180 < ad.J_hat[0] < 195  # the authors' first doubled-pole batch: 187.5
     rows = {r["name"]: r for r in rp.report(exp, recs)["configs"]}

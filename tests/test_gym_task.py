@@ -8,6 +8,7 @@ runs to the end of its budget.
 
 from __future__ import annotations
 
+import inspect
 import pickle
 import time
 from typing import Any
@@ -18,11 +19,13 @@ import pytest
 gym = pytest.importorskip("gymnasium")
 from gymnasium import spaces  # noqa: E402
 
+from safepg.definition import UnnamedError  # noqa: E402
 from safepg.envs import GymTask  # noqa: E402
 from safepg.envs.gym_task import with_bias  # noqa: E402
 from safepg.learning import adaptive_pg, vanilla_pg  # noqa: E402
-from safepg.options import Batches, ErrorModel, FixedStep, Gradient  # noqa: E402
+from safepg.options import Batches, ErrorModel, FixedStep, Gradient, Vanilla  # noqa: E402
 from safepg.policies import LinearGaussianPolicy  # noqa: E402
+from safepg.runner import RunConfig  # noqa: E402
 
 #: The counter env terminates once its state reaches this value.
 END = 3
@@ -71,7 +74,8 @@ def counter_task(**kw: Any) -> GymTask:
 def test_simulation_constants_are_required_at_construction(missing: str) -> None:
     args = {"horizon": 5, "gamma": 0.5}
     del args[missing]
-    with pytest.raises(ValueError, match=rf"^{missing} must be given"):
+    assert inspect.signature(GymTask).parameters[missing].default is inspect.Parameter.empty
+    with pytest.raises(TypeError, match=rf"required keyword-only argument: '{missing}'"):
         GymTask(CounterEnv, **args)
 
 
@@ -216,7 +220,10 @@ def test_learning_loops_accept_the_task() -> None:
     task = counter_task()
     rec = vanilla_pg(task, 0.0, 1.0, batch_size=8, step=FixedStep(0.01), budget=32, rng=0)
     assert rec.iterations == 4 and np.all(np.isnan(rec.J)) and np.all(np.isfinite(rec.J_hat))
-    assert "GymTask('CounterEnv'" in rec.config["task"]
+    # No closed-form J: its improvement ratio is unknown (NaN), not 0; J_hat's is measured.
+    assert np.isnan(rec.improvement_ratio()) and np.isnan(rec.summary()["improvement_ratio"])
+    assert 0.0 <= rec.improvement_ratio("J_hat") <= 1.0
+    assert rec.config["task"]["type"] == "GymTask" and rec.config["task"]["env_factory"].endswith(":CounterEnv")
     task.close()
     rec = adaptive_pg(task, 0.0, 1.0, batches=Batches(8, 16), budget=40, rng=0)  # simulating again after close
     assert rec.trajectories == 40
@@ -276,3 +283,46 @@ def test_adaptive_pg_runs_on_pendulum() -> None:
     print(f"adaptive PG on Pendulum-v1: c = {rec.config['c']:.3g}, batch sizes {rec.batch_size.tolist()}, "
           f"alpha {rec.alpha.tolist()}, safe {rec.safe.tolist()}; J {J0:.4f} +- {h0:.2f} -> {J1:.4f} +- {h1:.2f} "
           f"(moved {J1 - J0:+.2e}; same episodes), {time.perf_counter() - start:.1f} s")
+
+
+# ------------------------------------------------------------------------- stored runs
+def _bias_features(obs: np.ndarray) -> np.ndarray:
+    return with_bias(obs)
+
+
+PENDULUM = dict(horizon=20, gamma=0.9, reward_bound=16.3, feature_bound=8.0)
+
+
+def test_every_argument_of_a_stored_task_is_in_its_run_key() -> None:
+    """A run is found by its task's whole definition: change any argument and it is another run."""
+    def key(**kw: Any) -> str:
+        return RunConfig("own", method=Vanilla(8, FixedStep(0.01)), task=GymTask("Pendulum-v1", **{**PENDULUM, **kw}),
+                         theta0=(0.0,) * 3, budget=32).key()
+
+    base = key()
+    changed = [key(horizon=21), key(gamma=0.8), key(reward_bound=17.0), key(feature_bound=9.0),
+               key(action_volume=4.0), key(action_bound=2.5), key(features=_bias_features),
+               key(horizon_term="truncated"), key(measure="undiscounted"), key(env_kwargs={"g": 9.81}),
+               key(reset_options={"x_init": 0.3, "y_init": 0.3})]
+    assert base not in changed and len(set(changed)) == len(changed)
+    task = GymTask("Pendulum-v1", **PENDULUM, features=_bias_features)
+    cfg = RunConfig("own", task=task, theta0=(0.0,) * 4)
+    again = RunConfig.from_definition("own", cfg.definition())
+    assert again.key() == cfg.key() and again.make_task().features_name is None  # found again by its import name
+
+
+def test_a_stored_run_refuses_a_lambda_until_it_is_named() -> None:
+    lam = GymTask(lambda: CounterEnv(), horizon=5, gamma=0.5, reward_bound=3.0, feature_bound=2.0)
+    with pytest.raises(UnnamedError, match="give it a name"):
+        RunConfig("own", method=Vanilla(8, FixedStep(0.01)), task=lam, budget=32).key()
+    feats = GymTask(CounterEnv, horizon=5, gamma=0.5, reward_bound=3.0, feature_bound=2.0, features=lambda o: o)
+    with pytest.raises(UnnamedError):
+        RunConfig("own", task=feats).key()
+    # A record of a direct run keeps what it can, a run key needs the names.
+    rec = vanilla_pg(lam, 0.0, 1.0, batch_size=8, step=FixedStep(0.01), budget=16, rng=0)
+    assert rec.config["task"]["type"] == "unnamed"
+    named = [GymTask(lambda: CounterEnv(), horizon=5, gamma=0.5, reward_bound=3.0, feature_bound=2.0, name=n,
+                     features=lambda o: o, features_name=f) for n, f in (("counter-v1", "id"), ("counter-v2", "id"),
+                                                                         ("counter-v1", "id2"))]
+    keys = {RunConfig("own", task=t).key() for t in named}
+    assert len(keys) == 3

@@ -2,18 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import subprocess
 from pathlib import Path
 
 import nbformat
 import pytest
+from script_module import load
 
 ROOT = Path(__file__).resolve().parents[1]
-spec = importlib.util.spec_from_file_location("lab_copy", ROOT / "tools" / "lab_copy.py")
-lab_copy = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(lab_copy)
+lab_copy = load("tools/lab_copy.py")
 
 
 def notebook(path: Path, *sources: str, output: str | None = None) -> None:

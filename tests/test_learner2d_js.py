@@ -34,12 +34,13 @@ from scipy import stats
 from safepg.bounds import error_bound
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import learn
 from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant, scalar_step
-from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
+from safepg.thesis.explorers.option_names import learner_options
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
@@ -66,7 +67,7 @@ if (req.update) out.update = req.update.map(q => {
   const run = new L.VectorRun(q.cfg, q.task), x = f64(q.samples), n = q.n, m = run.m;
   run.batch.grow(n);
   for (let p = 0; p < m; p++) { let a = 0; for (let j = 0; j < n; j++) a += x[p * n + j]; run.grad[p] = a / n; }
-  const up = q.cfg.algorithm === "vanilla" ? run.vanilla(x, n) : run.adaptive(x, n, q.found);
+  const up = run.cfg.method === "Vanilla" ? run.vanilla(x, n) : run.adaptive(x, n, q.found);
   return {grad: Array.from(run.grad), step: Array.from(up.step), alpha: up.alpha, k: up.k, eps: up.eps, safe: up.safe,
           c: up.c, next_n: up.nextN, c_bounds: run.c};
 });
@@ -227,16 +228,16 @@ def test_gradient_samples_match_the_kernel(estimator, baseline, score, clip, dim
     batch = env.simulate(policy, n, np.random.default_rng(seed))
     U, Z = replay_draws(seed, [n], dim, env.horizon * dim)
     q = {"task": lqg_task_data(env), "theta": theta.tolist(), "sigma": sigma, "n": n, "m": m, "H": env.horizon,
-         "opt": {"estimator": estimator, "baseline": baseline, "score": score, "constants": "batch"},
+         "opt": {"estimator": estimator, "baseline": baseline, "scoreAction": score, "batchConstants": True},
          "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}
     js = run_node({"batch": [q]})["batch"][0]
     close_to_scale(np.array(js["samples"]).reshape(m, n).T, samples)
     np.testing.assert_allclose(js["returns"], returns, rtol=RTOL)
-    # constants="batch": the largest |reward| and |feature| of the batch, as safepg.learning measures them
+    # batchConstants: the largest |reward| and |feature| of the batch, as safepg.learning measures them
     assert js["found"] == pytest.approx([np.abs(batch.rewards).max(), np.abs(batch.features).max()], rel=RTOL)
 
 
-def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, float] | None,
+def expected_update(method: Adaptive | Vanilla, x: np.ndarray, found: tuple[float, float] | None,
                     k_task: TaskConstants) -> dict[str, Any]:
     """safepg.learning's rules (adaptive_pg, vanilla_pg) on samples x (n, m)."""
     n = x.shape[0]
@@ -245,50 +246,57 @@ def expected_update(cfg: dict[str, Any], x: np.ndarray, found: tuple[float, floa
     k = int(np.argmax(np.abs(grad)))
     g = float(abs(grad[k]))
     step = np.zeros_like(grad)
-    if cfg["algorithm"] == "vanilla":
-        grad_range = "empirical" if cfg["empiricalRange"] else "lemma"
-        eps = max(float(error_bound(cfg["bound"], x[:, i], cfg["delta"], k_task, "gpomdp", grad_range).eps(n))
+    if isinstance(method, Vanilla):
+        assert isinstance(method.step, SafeStep)
+        e = method.step.error
+        eps = max(float(error_bound(e.bound, x[:, i], e.delta, k_task, "gpomdp", e.range).eps(n))
                   for i in range(grad.size))
-        a = scalar_step(grad, eps, c_bounds) if cfg["step"] == "scalar" else coordinate_step(g, eps, c_bounds)
-        if cfg["step"] == "scalar":
+        scalar = method.step.kind == "scalar"
+        a = scalar_step(grad, eps, c_bounds) if scalar else coordinate_step(g, eps, c_bounds)
+        if scalar:
             step = a * grad
         else:
             step[k] = a * grad[k]
         return {"step": step, "alpha": a, "eps": eps, "safe": eps < g, "c": c_bounds, "next_n": n}
+    e, d, b = method.error, method.departures, method.batches
     batch_k, c = k_task, c_bounds
-    if cfg["constants"] == "batch":
+    if d.batch_constants:
         batch_k = replace(k_task, R=found[0], M_phi=found[1])
         c = penalty_constant(batch_k)
     spread = {}
-    if cfg["statistics"] == "max":
+    if d.maxima:
         spread = dict(variance=float(np.var(x, axis=0, ddof=1).max()), sample_range=float(np.ptp(x, axis=0).max()))
-    grad_range = "empirical" if cfg["empiricalRange"] else "lemma"
-    eb = error_bound(cfg["bound"], x[:, k], cfg["delta"], batch_k, "gpomdp", grad_range, **spread)
+    eb = error_bound(e.bound, x[:, k], e.delta, batch_k, "gpomdp", e.range, **spread)
     eps = float(eb.eps(n))
-    alpha = coordinate_step(g, eps, c, guarded=not cfg["stepWhenUnsafe"])
+    alpha = coordinate_step(g, eps, c, guarded=not d.unguarded_step)
     step[k] = alpha * grad[k]
     return {"step": step, "alpha": alpha, "eps": eps, "safe": eps < g, "c": c,
-            "next_n": optimal_batch_size(g, eb, c, cfg["nMin"], cfg["nMax"])}
+            "next_n": optimal_batch_size(g, eb, c, b.n_min, b.n_max)}
 
 
 def update_cases(task: dict[str, Any], k_task: TaskConstants, found_scale: float, rng: np.random.Generator,
                  tmp_path: Path, count: int = 120) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Random samples and every option, the JavaScript request and safepg's answers."""
+    """Random samples and every option, the JavaScript request and safepg's answers. The page's
+    configuration is the method's own (option_names.learner_options)."""
     cases, expected = [], []
     for i in range(count):
         n = int(rng.choice([2, 7, 130, 1000, 5000]))
         x = rng.standard_normal((n, 4)) * 10 ** rng.uniform(-1, 2, 4) + 10 ** rng.uniform(-2, 1.5, 4)
         x *= rng.choice([-1, 1], 4)
-        algorithm = ("adaptive", "vanilla")[i % 2]
-        cfg = {"algorithm": algorithm, "bound": ("chebyshev", "hoeffding", "bernstein")[i % 3],
-               "empiricalRange": bool(rng.integers(2)) or i % 3 == 0, "delta": float(rng.uniform(0.05, 0.95)),
-               "constants": ("bounds", "batch")[(i // 2) % 2], "statistics": ("component", "max")[(i // 4) % 2],
-               "stepWhenUnsafe": bool((i // 8) % 2), "nMin": 10, "nMax": 100_000, "budget": 10**7,
-               "step": ("scalar", "coordinate")[(i // 2) % 2], "alpha": None, "batchSize": n, "estimator": "gpomdp"}
-        found = (1.0, float(found_scale * rng.uniform(0.5, 1))) if cfg["constants"] == "batch" else None
-        cases.append({"cfg": cfg, "task": task, "n": n, "found": found,
+        error = ErrorModel(("chebyshev", "hoeffding", "bernstein")[i % 3], float(rng.uniform(0.05, 0.95)),
+                           "empirical" if bool(rng.integers(2)) or i % 3 == 0 else "lemma")
+        method: Adaptive | Vanilla
+        if i % 2 == 0:
+            method = Adaptive(error=error, batches=Batches(10, 100_000),
+                              departures=Departures(batch_constants=bool((i // 2) % 2), maxima=bool((i // 4) % 2),
+                                                    unguarded_step=bool((i // 8) % 2)))
+        else:
+            method = Vanilla(n, SafeStep(("scalar", "coordinate")[(i // 2) % 2], error))
+        batch = isinstance(method, Adaptive) and method.departures.batch_constants
+        found = (1.0, float(found_scale * rng.uniform(0.5, 1))) if batch else None
+        cases.append({"cfg": {**learner_options(method), "budget": 10**7}, "task": task, "n": n, "found": found,
                       "samples": save(tmp_path / f"x{i}.bin", x.T.ravel())})
-        expected.append(expected_update(cfg, x, found, k_task))
+        expected.append(expected_update(method, x, found, k_task))
     return cases, expected
 
 
@@ -323,13 +331,10 @@ AUTHORS_OPTIONS = dict(error=BERNSTEIN_ER, batches=Batches(n_max=100_000),
 def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     seed, budget = 8, 40_000
-    if kind == "adaptive-authors":
-        py = adaptive_pg(ENV, np.zeros(4), 1.0, budget=budget, rng=seed, **AUTHORS_OPTIONS)
-        cfg = {"bound": "bernstein", "empiricalRange": True, "statistics": "max", "stepWhenUnsafe": True,
-               "nMax": 100_000}
-    else:
-        py = vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep(kind), budget=budget, rng=seed)
-        cfg = {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": kind}
+    method = (Adaptive(**AUTHORS_OPTIONS) if kind == "adaptive-authors"
+              else Vanilla(2000, SafeStep(kind)))
+    py = learn(ENV, method, np.zeros(4), 1.0, budget=budget, rng=seed)
+    cfg = learner_options(method)
     U, Z = replay_draws(seed, py.batch_size, 2, ENV.horizon * 2)
     js = run_node({"replay": {"cfg": {**cfg, "budget": budget}, "task": TASK, "H": ENV.horizon,
                               "U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}})["replay"]
@@ -344,33 +349,22 @@ def test_whole_run_with_safepgs_random_numbers(kind, tmp_path):
 # --------------------------------------------------------------------------- stochastic parts
 SEEDS = 30
 #: name -> (safepg call, the JavaScript cfg); budgets small enough for a minute in all.
-SETTINGS: dict[str, tuple[Any, dict[str, Any]]] = {
-    "adaptive, Bernstein (e.r.), 10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, error=BERNSTEIN_ER, budget=100_000, rng=s),
-        {"bound": "bernstein", "empiricalRange": True, "budget": 100_000}),
-    "adaptive, authors' options, 10^5": (
-        lambda s: adaptive_pg(ENV, np.zeros(4), 1.0, budget=100_000, rng=s, **AUTHORS_OPTIONS),
-        {"bound": "bernstein", "empiricalRange": True, "budget": 100_000, "nMax": 100_000, "statistics": "max",
-         "stepWhenUnsafe": True}),
-    "scalar step of Pirotta et al. (2013), N = 2000, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep("scalar"), budget=100_000,
-                             rng=s),
-        {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "scalar", "budget": 100_000}),
-    "coordinate step, N = 2000, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=2000, step=SafeStep("coordinate"), budget=100_000,
-                             rng=s),
-        {"algorithm": "vanilla", "batchSize": 2000, "alpha": None, "step": "coordinate", "budget": 100_000}),
-    "N = 100, alpha = 10^-6, REINFORCE, 10^5": (
-        lambda s: vanilla_pg(ENV, np.zeros(4), 1.0, batch_size=100, step=FixedStep(1e-6),
-                             gradient=Gradient("reinforce"), budget=100_000, rng=s),
-        {"algorithm": "vanilla", "batchSize": 100, "alpha": 1e-6, "estimator": "reinforce", "budget": 100_000}),
+SETTINGS: dict[str, Adaptive | Vanilla] = {
+    "adaptive, Bernstein (e.r.), 10^5": Adaptive(error=BERNSTEIN_ER),
+    "adaptive, authors' options, 10^5": Adaptive(**AUTHORS_OPTIONS),
+    "scalar step of Pirotta et al. (2013), N = 2000, 10^5": Vanilla(2000, SafeStep("scalar")),
+    "coordinate step, N = 2000, 10^5": Vanilla(2000, SafeStep("coordinate")),
+    "N = 100, alpha = 10^-6, REINFORCE, 10^5": Vanilla(100, FixedStep(1e-6), Gradient("reinforce")),
 }
+#: Every setting's budget.
+BUDGET = 100_000
 
 
 def agreement(name: str, seeds: int = SEEDS) -> list[dict[str, Any]]:
-    call, cfg = SETTINGS[name]
+    method = SETTINGS[name]
+    cfg = {**learner_options(method), "budget": BUDGET}  # the page's configuration of the same method
     js = run_node({"seeds": [{"task": TASK, "cfg": {**cfg, "seed": k}} for k in range(seeds)]})["seeds"]
-    py = one_thread(lambda: [call(1000 + k) for k in range(seeds)])
+    py = one_thread(lambda: [learn(ENV, method, np.zeros(4), 1.0, budget=BUDGET, rng=1000 + k) for k in range(seeds)])
     values = {"mean J_hat over the run": ([s["upsilon_bar"] for s in js], [r.upsilon_bar() for r in py]),
               "final J": ([s["J_final"] for s in js], [r.J[-1] for r in py]),
               "final theta_00": ([s["theta_final"][0] for s in js], [r.theta[-1, 0] for r in py]),

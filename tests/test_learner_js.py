@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import pytest
 from scipy import stats
+from test_learner2d_js import replay_draws, save
 
 from safepg.bounds import (
     ErrorBound,
@@ -37,9 +38,9 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.learning import adaptive_pg, vanilla_pg
+from safepg.learning import adaptive_pg, learn, vanilla_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
-from safepg.options import ErrorModel, FixedStep, Gradient
+from safepg.options import Adaptive, ErrorModel, FixedStep, Gradient
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.live_learner import (
     learner_js,
@@ -49,6 +50,7 @@ from safepg.thesis.explorers.live_learner import (
     summary_text,
     task_data,
 )
+from safepg.thesis.explorers.option_names import learner_options
 
 NODE = shutil.which("node")
 # Node requires it by path: the learner as the page loads it, its files concatenated.
@@ -67,60 +69,40 @@ const L = require(process.argv[2]);
 const fs = require("fs");
 const req = JSON.parse(fs.readFileSync(0, "utf8"));
 const f64 = p => { const b = fs.readFileSync(p); return new Float64Array(b.buffer, b.byteOffset, b.length / 8); };
-const task = Object.assign({}, L.THESIS_1D, req.task || {});
+const task = req.task;  // live_learner.task_data(): the 1-D LQG as the page's learner reads it
 const out = {};
 if (req.updates) out.updates = req.updates.map(u => {
+  // One update of Algorithm 4.1 on given samples, by the page's run (its gradient and its rule).
   const x = Float64Array.from(u.samples), n = x.length;
-  const k = {R: task.R, M: task.M, Avol: task.Avol, Abar: task.Abar, gamma: task.gamma, H: task.H, sigma: u.sigma};
-  const c = L.penaltyConstant(k), grad = L.pairwiseSum(x, 0, n) / n;
-  const cfg = {bound: u.bound, delta: u.delta, estimator: u.estimator, empiricalRange: u.empirical_range,
-               theoreticalRange: null, nMin: 100, nMax: 500000};
-  const up = L.adaptiveUpdate(cfg, x, n, grad, k, c, new Float64Array(n));
-  return {c: c, grad: grad, var: L.sampleVariance(x, n, new Float64Array(n)), range: L.range(x, n),
+  const run = new L.VectorRun({...u.cfg, sigma: u.sigma, theta0: u.theta}, task);
+  run.batch.grow(n);
+  run.gradient(x, n);
+  const k = run.k, up = run.adaptive(x, n, null);
+  return {c: run.c, grad: run.grad[0], var: L.sampleVariance(x, n, new Float64Array(n)), range: L.range(x, n),
           var_reinforce: L.reinforceVarianceFactor(k), var_gpomdp: L.gpomdpVarianceFactor(k),
           range_bound: L.gradientRangeBound(k), d: up.d, f: up.f, eps: up.eps, alpha: up.alpha,
-          theta: u.theta + up.step, safe: up.safe, next_n: up.nextN};
+          theta: u.theta + up.step[0], safe: up.safe, next_n: up.nextN};
 });
 if (req.nstar) out.nstar = req.nstar.map(q => L.nStarSearch(q.g, {d: q.d, f: q.f}, q.c, q.n_max));
 if (req.J) out.J = req.J.map(q => {
-  const v = L.lqgPerformance(q.theta, q.sigma, task);
+  const v = L.lqgPerformanceN([q.theta], q.sigma, task);
   return isFinite(v) ? v : null;
 });
 if (req.kernel) {
-  const s0 = f64(req.kernel.s0), z = f64(req.kernel.z), H = task.H;
+  // One batch fed safepg's draws (trajectory by trajectory: its initial state, then its H normals).
+  const U = f64(req.kernel.U), Z = f64(req.kernel.Z), n = U.length;
   out.kernel = req.kernel.cases.map(q => {
-    let pos = 0;
-    const draw = (s, zz, count) => {
-      for (let j = 0; j < count; j++) s[j] = s0[pos + j];
-      zz.set(z.subarray(pos * H, (pos + count) * H));
-      pos += count;
-    };
-    const ws = new L.Workspace(H);
-    L.gradientSamples(q.theta, q.sigma, s0.length, Object.assign({}, task, {clip: q.clip}), q, ws, draw);
-    return {samples: Array.from(ws.samples.subarray(0, s0.length)),
-            returns: Array.from(ws.returns.subarray(0, s0.length))};
+    const b = new L.LqgBatch({...task, clip: q.clip});
+    b.run(Float64Array.of(q.theta), q.sigma, n, q.opt, L.arraySource(U, Z, task.H));
+    return {samples: Array.from(b.samples.subarray(0, n)), returns: Array.from(b.returns.subarray(0, n))};
   });
 }
 if (req.replay) {
-  // A whole run fed numpy's random numbers: each batch reads its n initial states, then its n*H normals.
-  const q = req.replay, s0 = f64(q.s0), z = f64(q.z), H = task.H;
-  let ps = 0, pz = 0, left = 0, batchZ = 0;
-  const run = new L.Run(q.cfg, task, null);
-  run.draw = (s, zz, count) => {
-    if (left === 0) { left = run.curN; batchZ = pz; pz += run.curN * H; }  // start of a batch
-    for (let j = 0; j < count; j++) s[j] = s0[ps + j];
-    zz.set(z.subarray(batchZ, batchZ + count * H));
-    ps += count; batchZ += count * H; left -= count;
-  };
-  const step = run.step.bind(run);
-  run.step = () => { run.curN = Math.min(run.n, run.cfg.budget - run.used); return step(); };
-  run.finish();
-  out.replay = run.rec;
+  // A whole run fed safepg's draws: each batch reads its next n trajectories.
+  const q = req.replay;
+  out.replay = new L.VectorRun(q.cfg, task, L.arraySource(f64(q.U), f64(q.Z), task.H)).finish().rec;
 }
-if (req.seeds) out.seeds = req.seeds.map(q => {
-  const r = new L.Run(q.cfg, task).finish();
-  return L.summary(r.rec, [100000, 1000000]);
-});
+if (req.seeds) out.seeds = req.seeds.map(q => L.summary(new L.VectorRun(q.cfg, task).finish().rec, [100000, 1000000]));
 if (req.normals) {
   const r = new L.Rng(req.normals.seed, 0), buf = new Float64Array(req.normals.n);
   r.fillNormal(buf, 0, buf.length);
@@ -134,7 +116,7 @@ if (req.page) {
   out.page = req.page.cases.map(q => {
     const runs = {};
     for (const [name, r] of Object.entries(q.runs)) {
-      const run = r.cfg ? new L.Run(r.cfg, task).finish() : null, rec = run ? run.rec : r.rec;
+      const run = r.cfg ? new L.VectorRun(r.cfg, task).finish() : null, rec = run ? run.rec : r.rec;
       runs[name] = Object.assign({}, rec, {used: rec.batchSize.reduce((a, b) => a + b, 0), done: true,
                                             diverged: run ? run.diverged : false, ms: 0});
     }
@@ -146,7 +128,8 @@ process.stdout.write(JSON.stringify(out));
 
 
 def run_node(request: dict[str, Any]) -> dict[str, Any]:
-    """Answer of the harness to one request (see HARNESS)."""
+    """Answer of the harness to one request (see HARNESS), on the 1-D LQG of the page."""
+    request = {"task": task_data(), **request}
     with tempfile.NamedTemporaryFile("w", suffix=".js", delete=False) as f:
         f.write(HARNESS)
     try:
@@ -172,33 +155,40 @@ def random_samples(rng: np.random.Generator) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------ deterministic parts
-#: Fixed-seed 1-D runs of the learner before it was split into files and widened to vector tasks
-#: (the learner.js of commit 910a88b): the SHA-256 of JSON.stringify(record), iterations, final theta.
-ONE_D_BEFORE = [
-    ({"algorithm": "adaptive", "seed": 7, "budget": 200000, "bound": "bernstein", "empiricalRange": True},
-     "056c404e49f0d169814f517b269ce49a7224baee9e4258a4d7645916df1b1a90", 841, -0.14685914910472053),
-    ({"algorithm": "adaptive", "seed": 3, "budget": 100000, "bound": "chebyshev", "estimator": "reinforce",
-      "theta0": -0.3}, "012be13142b11071f9a2f08ff13cd8b9185957f38a0e392004c7881c3f619012", 3, -0.3000689103392606),
-    ({"algorithm": "vanilla", "seed": 5, "stream": 1, "budget": 30000, "batchSize": 100, "alpha": 1e-3, "score": "raw"},
-     "48d9f36caaed51c7bf2260ed127bc0687f457fb47d754d8463b8b496ed3adbb6", 300, -0.6006164702129522),
+#: Fixed-seed 1-D runs of the page's learner (the VectorRun of vector_run.js on the 1-D LQG, m = 1):
+#: the SHA-256 of JSON.stringify(record), iterations, final theta. Captured when the 1-D page moved
+#: from its own loop to VectorRun; a change to any number of a seeded run changes them.
+ONE_D_PINNED = [
+    ({"seed": 7, "budget": 200000, "bound": "bernstein", "range": "empirical"},
+     "69c8d59790ce4a6cde37ab6bae8a9fbe65e53e6d9f196e51b4117babb6b228e3", 842, -0.14709505070355763),
+    ({"seed": 3, "budget": 100000, "bound": "chebyshev", "estimator": "reinforce", "theta0": -0.3},
+     "bb2aa2bae265b69d39b48a3f76b9804df041d73612ef64c271914201c8a1a0f7", 3, -0.3000652962636855),
+    ({"method": "Vanilla", "seed": 5, "stream": 1, "budget": 30000, "batchSize": 100, "step": "FixedStep",
+      "alpha": 1e-3, "scoreAction": "raw"},
+     "333a1d424e264a4a673a436dba81006ed6453a94a90754d1639815a0b484a544", 300, -0.6019905175421846),
 ]
 
 
-def test_one_d_runs_are_what_they_were():
-    """The 1-D explorer gives the same record for the same seed as before the vector tasks, through
-    Run and through the Driver with the 1-D task of safepgLearner.lqgTask."""
+def one_d_runs(cfgs: list[dict[str, Any]]) -> list[list[Any]]:
+    """Per configuration: the record's hash, iterations, final theta, and whether the Driver (as
+    the page's worker runs it) gives the same thetas."""
     script = (f"const L = require({json.dumps(str(LEARNER))}); const h = require('crypto');"
-              "const cfgs = JSON.parse(process.argv[1]); const out = cfgs.map(c => {"
-              "  const r = new L.Run(c).finish(), s = JSON.stringify(r.rec);"
-              "  const d = new L.Driver({task: L.lqgTask({dim: 1}), runs: [{name: 'x', cfg: c}]});"
+              "const [task, cfgs] = JSON.parse(process.argv[1]); const out = cfgs.map(c => {"
+              "  const r = new L.VectorRun(c, task).finish(), s = JSON.stringify(r.rec);"
+              "  const d = new L.Driver({task: task, runs: [{name: 'x', cfg: c}]});"
               "  const th = []; while (!d.done) for (const p of d.advance(100)) th.push(...p.theta);"
               "  return [h.createHash('sha256').update(s).digest('hex'), r.rec.batchSize.length,"
               "          r.rec.theta[r.rec.theta.length - 1],"
               "          JSON.stringify(th) === JSON.stringify(r.rec.theta.slice(1))];"
               "}); console.log(JSON.stringify(out));")
-    proc = subprocess.run([NODE, "-e", script, json.dumps([c for c, *_ in ONE_D_BEFORE])], capture_output=True,
-                          text=True, check=True)
-    for (_, sha, iterations, theta), got in zip(ONE_D_BEFORE, json.loads(proc.stdout)):
+    proc = subprocess.run([NODE, "-e", script, json.dumps([task_data(), cfgs])], capture_output=True, text=True,
+                          check=True)
+    return json.loads(proc.stdout)
+
+
+def test_one_d_runs_are_pinned():
+    """The 1-D explorer gives the same record for the same seed, through VectorRun and through the Driver."""
+    for (_, sha, iterations, theta), got in zip(ONE_D_PINNED, one_d_runs([c for c, *_ in ONE_D_PINNED])):
         assert got == [sha, iterations, theta, True]
 
 
@@ -220,8 +210,8 @@ def test_bounds_step_and_batch_size_match_safepg():
         g = abs(grad)
         eps = float(eb.eps(n))
         alpha = coordinate_step(g, eps, c)
-        cases.append({"samples": x.tolist(), "sigma": sigma, "delta": delta, "bound": bound, "empirical_range": er,
-                      "estimator": est, "theta": theta})
+        cfg = {"bound": bound, "delta": delta, "estimator": est, "range": "empirical" if er else "lemma"}
+        cases.append({"samples": x.tolist(), "sigma": sigma, "theta": theta, "cfg": cfg})
         expected.append({"c": c, "grad": grad, "var": float(np.var(x, ddof=1)), "range": float(np.ptp(x)),
                          "var_reinforce": reinforce_variance_factor(k), "var_gpomdp": gpomdp_variance_factor(k),
                          "range_bound": gradient_range_bound(k), "d": eb.d, "f": eb.f, "eps": eps, "alpha": alpha,
@@ -266,20 +256,20 @@ def test_closed_form_performance_matches_safepg():
 def test_gradient_samples_match_numba_kernel(clip, tmp_path):
     from safepg.envs._lqg_kernel import lqg1d_gradient_samples
 
-    n, H = 3001, 20  # several of the page's 1024-trajectory chunks
+    n, H = 3001, 20
     key = batch_key(np.random.default_rng(5))
     uniforms, normals = trajectory_draws(key, n, 1, H)  # what the numba kernel draws for this key
-    s0, z = -2.0 + 4.0 * uniforms, normals
-    s0.tofile(tmp_path / "s0.bin")
-    z.tofile(tmp_path / "z.bin")
-    cases = [{"theta": th, "sigma": sg, "estimator": est, "baseline": bl, "score": sc, "clip": clip}
+    uniforms.ravel().tofile(tmp_path / "u.bin")
+    normals.ravel().tofile(tmp_path / "z.bin")
+    cases = [{"theta": th, "sigma": sg, "clip": clip, "opt": {"estimator": est, "baseline": bl, "scoreAction": sc}}
              for th, sg in ((-0.3, 1.0), (0.0, 0.4), (-1.2, 1.9)) for est in ("reinforce", "gpomdp")
              for bl in (True, False) for sc in ("clipped", "raw")]
-    got = run_node({"kernel": {"s0": str(tmp_path / "s0.bin"), "z": str(tmp_path / "z.bin"), "cases": cases}})["kernel"]
+    got = run_node({"kernel": {"U": str(tmp_path / "u.bin"), "Z": str(tmp_path / "z.bin"), "cases": cases}})["kernel"]
     for q, js in zip(cases, got):
+        o = q["opt"]
         samples, returns = lqg1d_gradient_samples(q["theta"], q["sigma"], 1.0, 1.0, 1.0, 1.0, key, n, H, 0.9, 2.0, 2.0,
-                                                  clip, q["score"] == "clipped", q["estimator"] == "reinforce",
-                                                  q["baseline"])
+                                                  clip, o["scoreAction"] == "clipped", o["estimator"] == "reinforce",
+                                                  o["baseline"])
         scale = np.max(np.abs(samples))  # a baseline-corrected sample near 0 is compared at the batch's scale
         np.testing.assert_allclose(js["samples"], samples[:, 0], rtol=RTOL, atol=RTOL * scale, err_msg=str(q))
         np.testing.assert_allclose(js["returns"], returns, rtol=RTOL, err_msg=str(q))
@@ -290,21 +280,12 @@ def test_gradient_samples_match_numba_kernel(clip, tmp_path):
 def test_whole_run_with_safepgs_random_numbers(bound, er, estimator, tmp_path):
     """Fed the random numbers safepg draws, the page's learner makes the same run."""
     env, budget, seed, sigma, delta = LQG.thesis_1d(), 60_000, 4, 0.8, 0.6
-    py = adaptive_pg(env, 0.0, sigma, gradient=Gradient(estimator),
-                     error=ErrorModel(bound, delta, "empirical" if er else "lemma"), budget=budget, rng=seed)
-    # Redraw the same numbers: per batch, one key; trajectory i: its initial state, then H normals.
-    rng = np.random.default_rng(seed)
-    s0, z = [], []
-    for n in py.batch_size:
-        uniforms, normals = trajectory_draws(batch_key(rng), int(n), 1, env.horizon)
-        s0.append(-2.0 + 4.0 * uniforms[:, 0])
-        z.append(normals.ravel())
-    np.concatenate(s0).tofile(tmp_path / "s0.bin")
-    np.concatenate(z).tofile(tmp_path / "z.bin")
-    cfg = {"sigma": sigma, "estimator": estimator, "bound": bound, "empiricalRange": er, "delta": delta,
-           "budget": budget, "theta0": 0}
-    js = run_node({"replay": {"cfg": cfg, "s0": str(tmp_path / "s0.bin"), "z": str(tmp_path / "z.bin")},
-                   "task": task_data(env)})["replay"]
+    method = Adaptive(Gradient(estimator), ErrorModel(bound, delta, "empirical" if er else "lemma"))
+    py = learn(env, method, 0.0, sigma, budget=budget, rng=seed)
+    U, Z = replay_draws(seed, py.batch_size, 1, env.horizon)
+    cfg = {**learner_options(method), "sigma": sigma, "budget": budget, "theta0": 0}
+    draws = {"U": save(tmp_path / "u.bin", U), "Z": save(tmp_path / "z.bin", Z)}
+    js = run_node({"replay": {"cfg": cfg, **draws}})["replay"]
     assert py.iterations > 10
     assert js["batchSize"] == py.batch_size.tolist()
     np.testing.assert_allclose(js["theta"], py.theta[:, 0], rtol=1e-10, atol=1e-14)
@@ -390,12 +371,12 @@ def test_page_flags_a_frozen_run_of_its_own_learner():
     frozen, moving = page_params(**FROZEN), page_params(vanilla_n="off")
 
     def cfg(p: dict[str, Any]) -> dict[str, Any]:
-        return {"sigma": p["sigma"], "estimator": p["estimator"], "baseline": True, "score": p["score"],
+        return {"sigma": p["sigma"], "estimator": p["estimator"], "baseline": True, "scoreAction": p["score"],
                 "budget": int(p["budget"]), "seed": 0, "theta0": 0, "bound": p["bound"].replace("-er", ""),
-                "delta": p["delta"], "empiricalRange": p["bound"].endswith("-er")}
+                "delta": p["delta"], "range": "empirical" if p["bound"].endswith("-er") else "lemma"}
 
     got = run_node({"page": {"src": PAGE, "data": data, "cases": [
-        {"p": p, "runs": {"adaptive": {"cfg": cfg(p)}}} for p in (frozen, moving)]}, "task": task_data()})["page"]
+        {"p": p, "runs": {"adaptive": {"cfg": cfg(p)}}} for p in (frozen, moving)]}})["page"]
     f, m = (g["text"].split("<br>")[0] for g in got)
     assert got[0]["values"]["adaptive"]["theta_moved"] == 0 and got[0]["values"]["adaptive"]["ratio_vacuous"]
     assert f.endswith("; theta moved by 0, less than 0.1% of the way to theta* = -0.59: " + VACUOUS + "."), f
@@ -436,15 +417,13 @@ def agreement(bound: str, er: bool, estimator: str, sigma: float, seeds: int = S
     import numba
 
     env = LQG.thesis_1d()
-    cfg = {"sigma": sigma, "estimator": estimator, "bound": bound, "empiricalRange": er, "delta": 0.95,
-           "budget": budget}
+    method = Adaptive(Gradient(estimator), ErrorModel(bound, 0.95, "empirical" if er else "lemma"))
+    cfg = {**learner_options(method), "sigma": sigma, "budget": budget}
     js = run_node({"seeds": [{"cfg": {**cfg, "seed": k}} for k in range(seeds)]})["seeds"]
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # one core (the machine is shared)
     try:
-        py = [adaptive_pg(env, 0.0, sigma, gradient=Gradient(estimator),
-                          error=ErrorModel(bound, 0.95, "empirical" if er else "lemma"), budget=budget, rng=1000 + k)
-              for k in range(seeds)]
+        py = [learn(env, method, 0.0, sigma, budget=budget, rng=1000 + k) for k in range(seeds)]
     finally:
         numba.set_num_threads(threads)
     values = {

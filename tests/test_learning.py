@@ -1,5 +1,6 @@
 """Learning loops: determinism, record invariants, metrics, bad input."""
 
+import argparse
 import hashlib
 import json
 import subprocess
@@ -13,7 +14,7 @@ from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
-from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.tasks import MeasuredReturns
 
@@ -156,7 +157,7 @@ def test_nan_gradient_raises():
 
 
 def test_cli_learn_json(capsys):
-    assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--empirical-range",
+    assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--range", "empirical",
                  "--quiet", "--seed", "3"]) == 0
     out = json.loads(capsys.readouterr().out)
     for key in ("iterations", "trajectories", "theta", "J_initial", "J_star", "J_final", "J_at",
@@ -166,17 +167,40 @@ def test_cli_learn_json(capsys):
     assert out["J_initial"] == pytest.approx(-56.667, abs=1e-3)
     assert out["J_star"] == pytest.approx(-13.207, abs=1e-3)
     assert len(out["batch_sizes"]) == out["iterations"]
+    # The run's definition, in the option objects' names.
+    assert out["config"]["method"]["error"] == {"type": "ErrorModel", "bound": "bernstein", "delta": 0.95,
+                                                "range": "empirical"}
 
 
 def test_cli_vanilla(capsys):
-    assert main(["learn", "--fixed-alpha", "1e-4", "--fixed-n", "100", "--budget", "2000",
+    assert main(["learn", "--alpha", "1e-4", "--batch-size", "100", "--budget", "2000",
                  "--theta0", "-0.55", "--sigma", "0.5", "--quiet"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["batch_sizes"] == [100] * 20
+    assert out["config"]["method"]["step"] == {"type": "FixedStep", "alpha": 1e-4, "kind": "scalar"}
+
+
+@pytest.mark.parametrize("args,method", [
+    (["--first", "300", "--maxima", "--unguarded-step", "--no-baseline"],
+     Adaptive(Gradient(baseline=False), batches=Batches(first=300), departures=Departures(maxima=True,
+                                                                                          unguarded_step=True))),
+    (["--batch-size", "200", "--safe-step", "coordinate", "--bound", "hoeffding", "--range", "1280"],
+     Vanilla(200, SafeStep("coordinate", ErrorModel("hoeffding", 0.95, 1280.0)))),
+    (["--batch-size", "200", "--alpha", "0.01", "--kind", "coordinate", "--target", "-20", "--update"],
+     Vanilla(200, FixedStep(0.01, "coordinate"), target=Target(-20.0, True))),
+])
+def test_cli_flags_are_the_option_objects_fields(args, method):
+    from safepg.cli import _learn_parser, _method
+
+    parser = argparse.ArgumentParser()
+    _learn_parser(parser.add_subparsers())
+    assert _method(parser.parse_args(["learn", *args])) == method
 
 
 @pytest.mark.parametrize("args,word", [(["--delta", "1.5"], "delta"), (["--sigma", "0"], "sigma"),
-                                       (["--n-min", "10", "--n-max", "5"], "n_min")])
+                                       (["--n-min", "10", "--n-max", "5"], "n_min"),
+                                       (["--alpha", "0.1"], "--batch-size"),
+                                       (["--batch-size", "100"], "--alpha")])
 def test_cli_bad_input_one_line_no_traceback(args, word):
     p = subprocess.run([sys.executable, "-m", "safepg", "learn", "--quiet", "--budget", "1000", *args],
                        capture_output=True, text=True)
@@ -249,7 +273,7 @@ def _first_batch(env, theta0, n, seed):
 def test_n_first_sets_only_the_first_batch():
     kw = dict(error=ErrorModel("bernstein", range="empirical"), budget=20_000)
     rec = adaptive_pg(ENV, batches=Batches(n_min=10, first=1000), rng=np.random.default_rng(3), **kw)
-    assert rec.batch_size[0] == 1000 and rec.config["n_first"] == 1000
+    assert rec.batch_size[0] == 1000 and rec.config["method"]["batches"]["first"] == 1000
     # The rest follows N* clipped to [n_min, n_max]; without n_first the first batch is n_min.
     assert 1000 not in rec.batch_size[1:-1]
     default = adaptive_pg(ENV, batches=Batches(n_min=10), rng=3, **kw)
@@ -315,21 +339,16 @@ def test_update_at_target_updates_before_stopping():
     assert kept.reached_target and updated.reached_target and kept.iterations == updated.iterations == 1
     assert kept.theta[-1] == kept.theta[0] and updated.theta[-1] != updated.theta[0]
     np.testing.assert_allclose(updated.theta[-1] - updated.theta[0], 1e-3 * updated.grad[0])
-    assert updated.config["update_at_target"] is True and "update_at_target" not in kept.config
+    assert updated.config["method"]["target"]["update"] is True and kept.config["method"]["target"]["update"] is False
 
 
-def test_run_config_passes_the_options_and_keeps_unset_keys():
+def test_run_config_passes_the_options_and_hashes_its_definition():
     from safepg.options import Adaptive, Vanilla
     from safepg.runner import RESULTS_VERSION, RunConfig
 
     plain = RunConfig("a", budget=2000)
-    # The key of a config without the departures is the one it had before they existed: the
-    # hash of the flat fields the config had then, and the results version.
-    before = {"algorithm": "adaptive", "env": "lqg1d", "theta0": [0.0], "sigma": 1.0, "estimator": "gpomdp",
-              "baseline": True, "bound": "chebyshev", "delta": 0.95, "empirical_range": False, "n_min": 100,
-              "n_max": 500_000, "step": "scalar", "budget": 2000, "score_action": "clipped"}
-    assert plain.fields() == before
-    blob = json.dumps([before, RESULTS_VERSION], sort_keys=True)
+    # The key hashes the whole definition and the results version, nothing else.
+    blob = json.dumps([plain.definition(), RESULTS_VERSION], sort_keys=True)
     assert plain.key() == hashlib.sha256(blob.encode()).hexdigest()[:16]
     opts = RunConfig("a", budget=2000, method=Adaptive(batches=Batches(first=500), departures=Departures(
         batch_constants=True, maxima=True, unguarded_step=True)))
@@ -337,8 +356,9 @@ def test_run_config_passes_the_options_and_keeps_unset_keys():
     assert len({plain.key(), opts.key(), first100.key()}) == 3
     rec = opts.run(0)
     assert rec.batch_size[0] == 500
-    assert {k: rec.config[k] for k in ("n_first", "constants", "statistics", "step_when_unsafe")} == {
-        "n_first": 500, "constants": "batch", "statistics": "max", "step_when_unsafe": True}
+    assert rec.config["method"]["batches"]["first"] == 500
+    assert rec.config["method"]["departures"] == {"type": "Departures", "batch_constants": True, "maxima": True,
+                                                  "unguarded_step": True}
     # An option of the other method cannot be given at all; a method must be one of the two.
     with pytest.raises(TypeError):
         Vanilla(100, FixedStep(1e-3), batches=Batches(first=200))  # type: ignore[call-arg]

@@ -11,8 +11,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
 from safepg.thesis.experiments import get_experiment, t52_name
+from safepg.thesis.explorers.js_tasks import lqg_task_data
 from safepg.thesis.explorers.live_learner import (
     BUDGETS,
     STILL,
@@ -60,8 +62,12 @@ def test_page_is_self_contained():
 
 def test_task_is_the_thesis_1d_lqg():
     t = task_data()
-    assert (t["gamma"], t["H"], t["bs"], t["ba"], t["clip"]) == (0.9, 20, 2.0, 2.0, True)
-    assert (t["R"], t["M"], t["Avol"], t["Abar"]) == (4.0, 2.0, 4.0, 2.0)
+    assert t == lqg_task_data(LQG.thesis_1d())  # the task every page learner reads, with m = 1
+    assert (t["kind"], t["dim"], t["gamma"], t["H"], t["stateBound"], t["actionBound"], t["clip"]) == (
+        "lqg", 1, 0.9, 20, 2.0, 2.0, True)
+    assert (t["rewardBound"], t["featureBound"], t["actionVolume"]) == (4.0, 2.0, 4.0)
+    with pytest.raises(ValueError, match="one-dimensional"):
+        task_data(LQG.thesis_2d())
 
 
 def test_overlay_embeds_matching_stored_runs(stored):

@@ -13,10 +13,9 @@ import pytest
 from ch5_node import NODE, run_page
 
 from safepg.learning import learn
-from safepg.options import Departures, ErrorModel, FixedStep, SafeStep, Vanilla
+from safepg.options import Departures, ErrorModel, SafeStep, Vanilla
 from safepg.thesis.experiments import get_experiment
 from safepg.thesis.explorers.ch5_live import learner_source, record_c, record_trace
-from safepg.thesis.explorers.js_tasks import learner_options
 from safepg.thesis.explorers.lqg2d_learner import (
     adaptive_configs,
     adaptive_result,
@@ -27,6 +26,7 @@ from safepg.thesis.explorers.lqg2d_learner import (
     steps_configs,
     steps_result,
 )
+from safepg.thesis.explorers.option_names import learner_options
 
 needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
 
@@ -105,19 +105,20 @@ def test_page_configs_are_the_python_settings(steps, adaptive):
             p = {**base, **m}
             py = fn(p)
             js = {r["name"]: r["cfg"] for r in got["configs"]["runs"]}
+            completed = dict(zip(js, got["completed"]))
             assert list(js) == list(py)
             for name, method in py.items():
                 cfg = js[name]
                 assert cfg["sigma"] == p["sigma"] and cfg["seed"] == round(p["seed"])
                 assert cfg["theta0"] == [0.0] * 4 and cfg["budget"] == int(p["budget"])
-                fixed_step = isinstance(method, Vanilla) and isinstance(method.step, FixedStep)
                 if isinstance(method, Vanilla):
                     assert cfg["stopOnDivergence"] is True  # learn() stops a diverging vanilla run
-                for k, v in learner_options(method).items():
-                    if k not in cfg:  # the page leaves out what is at the learner's default
-                        assert (k, v) in {("theoreticalRange", None), ("constants", "bounds")}, (m, name, k)
-                    elif not (fixed_step and k in ("bound", "empiricalRange", "delta")):  # no bound in a fixed step
-                        assert cfg[k] == v, (m, name, k)
+                # The page's configuration, completed with the table's defaults as the learner completes
+                # it, is the method's own.
+                options = learner_options(method)
+                assert {k: completed[name][k] for k in options} == options, (m, name)
+                assert set(completed[name]) - set(options) == {"sigma", "seed", "theta0", "budget",
+                                                               "stopOnDivergence", "stream"}, (m, name)
     assert out_a[-2]["linked"] == {"n_max": "100000"} and out_a[-1]["linked"] == {"n_max": "500000"}
     assert [adaptive.linked("authors", v) for v in (True, False)] == [out_a[-2]["linked"], out_a[-1]["linked"]]
 

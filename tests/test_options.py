@@ -1,7 +1,7 @@
 """The option objects of the learning loops (safepg.options): each checks its own values by name
 and is frozen; the loops refuse an option of the wrong type; the same settings give the same run
-through the loops and through RunConfig; a RunConfig's flat fields and key do not depend on how
-its method is spelt."""
+through the loops and through RunConfig; a RunConfig's definition and key do not depend on how
+its method is spelt, and every field of the definition is in the key."""
 
 from __future__ import annotations
 
@@ -26,6 +26,7 @@ from safepg.options import (
     Vanilla,
 )
 from safepg.runner import RunConfig
+from safepg.thesis.experiments import LQG2D_TASK
 
 ENV = LQG.thesis_1d()
 ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J", "J_hat", "grad", "eps", "safe")
@@ -150,7 +151,7 @@ CONFIGS = [
     RunConfig("authors", method=Adaptive(error=ErrorModel("hoeffding", 0.95, 1280.0), batches=Batches(10, 5000, 300),
                                          departures=Departures(True, True, True)), budget=20_000),
     RunConfig("safe", method=Vanilla(500, SafeStep("coordinate", ErrorModel("chebyshev", 0.9))),
-              env="lqg2d", theta0=(0.0,) * 4, budget=5000),
+              task="lqg2d", theta0=(0.0,) * 4, budget=5000),
     RunConfig("fixed", method=Vanilla(200, FixedStep(1e-3), Gradient(baseline=False), Target(-3.75, True)),
               theta0=(-0.3,), sigma=0.5, budget=20_000),
 ]
@@ -158,40 +159,42 @@ CONFIGS = [
 
 @pytest.mark.parametrize("cfg", CONFIGS, ids=lambda c: c.name)
 def test_the_loops_and_run_config_give_the_same_record(cfg):
-    env, theta0, m = cfg.make_env(), np.asarray(cfg.theta0), cfg.method
+    env, theta0, m = cfg.make_task(), np.asarray(cfg.theta0), cfg.method
     rng = lambda: np.random.default_rng(cfg.seed(3))  # noqa: E731
     if isinstance(m, Adaptive):
         direct = adaptive_pg(env, theta0, cfg.sigma, gradient=m.gradient, error=m.error, batches=m.batches,
-                             departures=m.departures, budget=cfg.budget, rng=rng())
+                             departures=m.departures, budget=cfg.budget, rng=rng(), stop_on_divergence=True)
     else:
         direct = vanilla_pg(env, theta0, cfg.sigma, batch_size=m.batch_size, step=m.step, gradient=m.gradient,
                             target=m.target, budget=cfg.budget, rng=rng(), stop_on_divergence=True)
     stored = cfg.run(3)
     assert stored.iterations > 3 and stored.reached_target == (isinstance(m, Vanilla) and m.target is not None)
     assert same_record(direct, stored)
-    assert same_record(learn(env, m, theta0, cfg.sigma, budget=cfg.budget, rng=rng()), stored)
+    assert same_record(learn(env, m, theta0, cfg.sigma, budget=cfg.budget, rng=rng(), stop_on_divergence=True),
+                       stored)
     assert same_record(cfg.run(3), stored)  # and again: nothing depends on state left behind
     assert not np.array_equal(cfg.run(4).J_hat, stored.J_hat)  # another seed, another run
-    # The record's settings are the config's flat fields (plus the task and c).
-    flat = cfg.fields()
-    assert {k: v for k, v in stored.config.items() if k in flat} == {
-        k: v for k, v in flat.items() if k in stored.config}
+    # The record's settings are the config's definition, and the penalty constant c.
+    assert stored.config == {**cfg.definition(), "c": stored.config["c"]}
 
 
-# ------------------------------------------------------------------ fields() and key()
+# ------------------------------------------------------------------ definition() and key()
 def test_a_method_spelt_two_ways_has_one_key():
-    scalar = dict(env="lqg2d-gamma0.9", theta0=(0.0,) * 4)
+    scalar = dict(task=LQG2D_TASK, theta0=(0.0,) * 4)
     short = RunConfig("scalar", method=Vanilla(2000, SafeStep("scalar", ErrorModel())), **scalar)
     spelt = RunConfig("x", method=Vanilla(2000, SafeStep("scalar", ErrorModel("chebyshev", 0.95, "lemma")),
                                           Gradient("gpomdp", True, "clipped"), None), sigma=1.0, budget=30_000_000,
                       **scalar)
-    assert short.fields() == spelt.fields() and short.key() == spelt.key()
+    assert short.definition() == spelt.definition() and short.key() == spelt.key()
     assert short.key() == RECORDED["figures-5.5-5.6"]["scalar"]  # the stored runs' key
     plain, spelt = RunConfig("a"), RunConfig("b", method=Adaptive(Gradient(), ErrorModel(), Batches(100, 500_000, None),
                                                                   Departures(False, False, False)))
-    assert plain.key() == spelt.key() and plain.fields() == spelt.fields()
+    assert plain.key() == spelt.key() and plain.definition() == spelt.definition()
     assert RunConfig("a", method=Adaptive(error=ErrorModel("bernstein", 0.95, "empirical")),
-                     env="lqg2d-gamma0.9", theta0=(0.0,) * 4).key() == RECORDED["table-5.3"]["adaptive"]
+                     task=LQG2D_TASK, theta0=(0.0,) * 4).key() == RECORDED["table-5.3"]["adaptive"]
+    # A task by its preset's name or as the object: one task, one key.
+    assert RunConfig("a", task="lqg2d").key() == RunConfig("a", task=LQG.thesis_2d()).key()
+    assert RunConfig("a", task=LQG.thesis_1d(A=1.0)).key() == RunConfig("a", task=LQG.thesis_1d(A=[[1.0]])).key()
 
 
 def test_every_setting_of_a_method_is_in_the_key():
@@ -201,6 +204,7 @@ def test_every_setting_of_a_method_is_in_the_key():
                 Adaptive(error=ErrorModel(delta=0.5)), Adaptive(error=ErrorModel("hoeffding", range="empirical")),
                 Adaptive(error=ErrorModel("hoeffding", range=1280.0)), Adaptive(batches=Batches(n_min=10)),
                 Adaptive(batches=Batches(n_max=1000)), Adaptive(batches=Batches(first=1000)),
+                Adaptive(batches=Batches(first=100)),  # set, even to N_min, is set
                 *(Adaptive(departures=Departures(**{d: True})) for d in DEPARTURES)]
     vanilla = [Vanilla(100), Vanilla(200), Vanilla(100, FixedStep(1e-2)), Vanilla(100, FixedStep(1e-3, "coordinate")),
                Vanilla(100, gradient=Gradient("reinforce")), Vanilla(100, target=Target(195.0)),
@@ -214,47 +218,90 @@ def test_every_setting_of_a_method_is_in_the_key():
     assert not same
 
 
-#: Each option away from the algorithm: the method with it at its default and set, its flat
-#: name and value in fields().
-LEGACY = [
-    (Adaptive(), Adaptive(batches=Batches(first=1000)), "n_first", 1000),
-    (Adaptive(), Adaptive(batches=Batches(first=100)), "n_first", 100),  # set, even to N_min, is set
-    (Adaptive(), Adaptive(departures=Departures(batch_constants=True)), "constants", "batch"),
-    (Adaptive(), Adaptive(departures=Departures(maxima=True)), "statistics", "max"),
-    (Adaptive(), Adaptive(departures=Departures(unguarded_step=True)), "step_when_unsafe", True),
-    (Vanilla(4000, FixedStep(0.01), target=Target(195.0)),
-     Vanilla(4000, FixedStep(0.01), target=Target(195.0, update=True)), "update_at_target", True),
-    (Adaptive(error=ErrorModel("hoeffding")), Adaptive(error=ErrorModel("hoeffding", range=1280.0)),
-     "theoretical_range", 1280.0),
+#: Values a leaf of a definition may take, tried in turn for a changed one that is still valid.
+ALTERNATIVES = ("reinforce", "gpomdp", "raw", "clipped", "hoeffding", "bernstein", "chebyshev", "empirical",
+                "lemma", "scalar", "coordinate", "semi-implicit", "euler", "truncated", "effective", 3.5, 0.5, 7,
+                1000, (1.0, 2.0, 3.0, 4.0), None, True, False, {"type": "Target", "value": 195.0, "update": False})
+
+
+def _leaves(d, path=()):
+    """(path, value) of every field of a definition, a task's matrix as one value."""
+    if isinstance(d, dict):
+        for k, v in d.items():
+            if k != "type":
+                yield from _leaves(v, (*path, k))
+    else:
+        yield path, d
+
+
+def _changed(d, path, value):
+    if not path:
+        return value
+    return {**d, path[0]: _changed(d[path[0]], path[1:], value)}
+
+
+def _alternatives(value):
+    if isinstance(value, list):  # theta0 or a matrix: change its first entry
+        flat = np.asarray(value, dtype=float)
+        yield (flat + np.eye(*flat.shape) if flat.ndim == 2 else flat + 0.5).tolist()
+        return
+    if isinstance(value, bool):
+        yield not value
+    elif isinstance(value, int | float) and value:
+        yield type(value)(value * 2) if isinstance(value, int) else value / 2
+    yield from (a for a in ALTERNATIVES if a != value and not (isinstance(a, bool) and not isinstance(value, bool)))
+
+
+#: One configuration of each method, on each core task, warm-started or not.
+DEFINED = [
+    RunConfig("adaptive", method=Adaptive(batches=Batches(first=300)), task="lqg1d"),
+    RunConfig("safe", method=Vanilla(500, SafeStep("scalar", ErrorModel("hoeffding", 0.9, 1280.0)),
+                                     target=Target(-3.0)), task="lqg2d", theta0=(0.0,) * 4),
+    RunConfig("cartpole", method=Vanilla(4000, FixedStep(0.01, "coordinate")), task="cartpole-doubled",
+              warm_start="cartpole-baseline", warm_start_key="0123456789abcdef"),
 ]
-OPTIONAL = ("n_first", "constants", "statistics", "step_when_unsafe", "update_at_target", "theoretical_range")
 
 
-@pytest.mark.parametrize("unset,method,name,value", LEGACY, ids=[n for *_, n, _ in LEGACY])
-def test_an_option_is_in_fields_under_its_legacy_name_only_when_set(unset, method, name, value):
-    cfg, default = RunConfig("a", method=method), RunConfig("a", method=unset)
-    assert not set(OPTIONAL) & set(default.fields())
-    f = cfg.fields()
-    assert f[name] == value and set(OPTIONAL) & set(f) == {name}
-    assert {k: v for k, v in f.items() if k != name} == default.fields()
-    assert cfg.key() != default.key()
+@pytest.mark.parametrize("cfg", DEFINED, ids=lambda c: c.name)
+def test_every_field_of_the_definition_is_in_the_key(cfg):
+    """Each field changed alone, to any other value its object accepts, gives another key."""
+    d = cfg.definition()
+    assert RunConfig.from_definition(cfg.name, d, cfg.warm_start).definition() == d  # the round trip
+    checked = []
+    for path, value in _leaves(d):
+        for alt in _alternatives(value):
+            try:
+                other = RunConfig.from_definition(cfg.name, _changed(d, path, alt), cfg.warm_start)
+                key = other.key()
+            except (ValueError, TypeError):
+                continue  # not a value this field takes
+            if other.definition() == d:
+                continue  # the same definition spelt otherwise (an int for a float)
+            assert key != cfg.key(), (path, value, alt)
+            checked.append(path)
+            break
+    # The LQG's dim changes only with its matrices (each is dim x dim): no value of it alone is valid.
+    # A warm-started run starts where its warm_start run ended: it has no theta0 of its own.
+    unchangeable = {("task", "dim")} | ({("theta0",)} if cfg.warm_start else set())
+    assert {p for p, _ in _leaves(d)} - set(checked) <= unchangeable
 
 
-def test_fields_of_each_method_hold_the_flat_names():
+def test_the_definition_holds_the_option_objects_field_names():
     van = RunConfig("v", method=Vanilla(500, FixedStep(1e-4, "coordinate"), Gradient("reinforce", False, "raw"),
                                         Target(-20.0)), budget=1000)
-    assert van.fields() == {
-        "algorithm": "vanilla", "env": "lqg1d", "theta0": [0.0], "sigma": 1.0, "estimator": "reinforce",
-        "baseline": False, "score_action": "raw", "bound": "chebyshev", "delta": 0.95, "empirical_range": False,
-        "budget": 1000, "n_min": 100, "n_max": 500_000, "batch_size": 500, "step": "coordinate", "alpha": 1e-4,
-        "target_return": -20.0}
+    d = van.definition()
+    assert d["method"] == {
+        "type": "Vanilla", "batch_size": 500, "step": {"type": "FixedStep", "alpha": 1e-4, "kind": "coordinate"},
+        "gradient": {"type": "Gradient", "estimator": "reinforce", "baseline": False, "score_action": "raw"},
+        "target": {"type": "Target", "value": -20.0, "update": False}}
+    assert d["task"]["type"] == "LQG" and d["task"]["A"] == [[1.0]] and d["task"]["gamma"] == 0.9
+    assert (d["theta0"], d["sigma"], d["budget"], d["stop_on_divergence"], d["warm_start"]) == ([0.0], 1.0, 1000,
+                                                                                                True, None)
     assert van.algorithm == "vanilla" and RunConfig("a").algorithm == "adaptive"
-    safe = RunConfig("s", method=Vanilla(500, SafeStep("scalar", ErrorModel("bernstein", 0.5, "empirical"))))
-    f = safe.fields()
-    assert (f["bound"], f["delta"], f["empirical_range"]) == ("bernstein", 0.5, True)
-    assert "alpha" not in safe.fields()  # a safe step has no alpha
     warm = RunConfig("w", warm_start="cartpole-baseline", warm_start_key="0123456789abcdef")
-    assert warm.fields()["warm_start"] == "cartpole-baseline" and "warm_start_key" not in warm.fields()
+    assert warm.definition()["warm_start"] == "0123456789abcdef" and warm.definition()["theta0"] is None
+    with pytest.raises(ValueError, match="^warm_start_key must be given"):
+        RunConfig("w", warm_start="cartpole-baseline").key()
 
 
 # ------------------------------------------------------------------ the departures and the theorems' assumptions

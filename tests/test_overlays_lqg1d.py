@@ -13,10 +13,10 @@ import pytest
 from safepg.envs.lqg import LQG
 from safepg.learning import vanilla_pg
 from safepg.options import FixedStep
+from safepg.record import on_trajectories
 from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis import overlays as O
-from safepg.thesis.analysis import performance_on_grid
 from safepg.thesis.experiments import get_experiment
 
 
@@ -105,12 +105,12 @@ def test_figures_5_1_5_2_overlay_carry_ours_and_the_authors_curves(figure):
         assert len(colours) == len(theirs) == len(configs)
         by_estimator = sorted(configs, key=lambda c: c.method.gradient.estimator != "gpomdp")
         for c, ours_line, their_line in zip(by_estimator, colours, theirs):
-            f = c.fields()
-            curve = authors.figure51_52_curves()[(f["estimator"], f["bound"], f["empirical_range"], f["delta"])]
+            e = c.method.error
+            curve = authors.figure51_52_curves()[(c.method.gradient.estimator, e.bound, e.empirical_range, e.delta)]
             assert np.array_equal(their_line.get_ydata(), curve["J"])
             grid = curve["trajectories"].astype(np.int64)
             assert np.array_equal(ours_line.get_xdata(), grid)
-            expected = np.nanmean(performance_on_grid(records[c.name], grid[:8]), axis=0)
+            expected = np.nanmean(on_trajectories(records[c.name], grid[:8]), axis=0)
             assert np.allclose(ours_line.get_ydata()[:8], expected, rtol=0, atol=1e-13)
             assert np.all(np.isnan(ours_line.get_ydata()[8:]))  # past our short runs' end
     finally:

@@ -4,8 +4,9 @@ Stored runs (``<results>/<experiment>/<config>/seed-<k>.npz``) are found, and ac
 their configuration's :meth:`safepg.runner.RunConfig.key`: a key that changes makes every
 stored run of that configuration stale, so the whole campaign (hours of computation) would be
 recomputed, and a refactor of the options or of how a configuration is spelt must not change
-any key. ``tests/data/run_keys.json`` holds ``{experiment: {config: key}}`` as captured before
-the options became objects (safepg.options); it is data, not a computation of the present code.
+any key. ``tests/data/run_keys.json`` holds ``{experiment: {config: key}}`` as captured when the
+key became the hash of the whole definition (RESULTS_VERSION 4); it is data, not a computation of
+the present code.
 
 When ``safepg.runner.RESULTS_VERSION`` is bumped on purpose (a change that alters the numbers
 a run produces), every key changes: regenerate the file then, and only then, with::

@@ -17,6 +17,7 @@ import pytest
 from safepg import runner, store
 from safepg.cli import main
 from safepg.learning import LearningRecord
+from safepg.options import FixedStep, Vanilla
 from safepg.thesis import experiment_store as es
 from safepg.thesis import experiments as ex
 
@@ -295,7 +296,7 @@ def test_zero_seeds_is_a_clear_error_without_traceback(tmp_path):
     (["learn", "--budget", "2.5e3.1"], "argument --budget: expected an integer"),
     (["learn", "--n-min", "0"], "argument --n-min: must be a positive integer"),
     (["learn", "--n-max", "1e5.5"], "argument --n-max: expected an integer"),
-    (["learn", "--fixed-n", "100.5", "--fixed-alpha", "1e-4"], "argument --fixed-n: expected a whole number"),
+    (["learn", "--batch-size", "100.5", "--alpha", "1e-4"], "argument --batch-size: expected a whole number"),
     (["learn", "--seed", "-1"], "argument --seed: must be a non-negative integer"),
 ])
 def test_bad_counts_name_the_parameter(tmp_path, monkeypatch, capsys, argv, message):
@@ -319,7 +320,7 @@ def test_counts_accept_exact_scientific_notation(tmp_path, monkeypatch, capsys):
 
     assert [integer(s) for s in ("1e6", "1E6", "3_000_000", "1.5e3", " 200 ", "2.0e2")] == [
         1_000_000, 1_000_000, 3_000_000, 1500, 200, 200]
-    code, out, _ = _cli(capsys, "learn", "--budget", "2e3", "--fixed-n", "1e2", "--fixed-alpha", "1e-4",
+    code, out, _ = _cli(capsys, "learn", "--budget", "2e3", "--batch-size", "1e2", "--alpha", "1e-4",
                         "--n-min", "1e2", "--n-max", "5e5", "--seed", "0e0", "--quiet")
     assert code == 0 and json.loads(out)["trajectories"] == 2000 and json.loads(out)["iterations"] == 20
     # run and report parse --budget 1e6 as 1000000 (here: nothing stored, so report says what to run).
@@ -365,3 +366,13 @@ def test_equal_budgets_put_the_smallest_fixed_batches_first(tmp_path, monkeypatc
     monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.name), compute(c, *a))[1])
     es.run_experiment(e, jobs=1, root=tmp_path, progress=False)
     assert order == ["N=100", "N=1000", "adaptive"]
+
+
+@pytest.mark.parametrize("as_text", [True, False])
+def test_a_folder_may_be_a_str_or_a_path(tmp_path, as_text):
+    cfg = runner.RunConfig("tiny", method=Vanilla(10, FixedStep(1e-3)), budget=40)
+    folder = str(tmp_path / "group") if as_text else tmp_path / "group"
+    recs = runner.run_configs([cfg], 2, folder, jobs=1, progress=False)
+    assert len(recs["tiny"]) == 2 and (tmp_path / "group" / "tiny" / "seed-1.npz").is_file()
+    again = runner.load_configs([cfg], 2, folder)["tiny"]
+    assert [r.config["seed"] for r in again] == [0, 1] and runner.stored_run(folder, cfg, 0) is not None

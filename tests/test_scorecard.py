@@ -220,8 +220,11 @@ def test_rows_carry_the_authors_columns(store):
     ids = by_id(rows)
     t51 = [r for r in rows if r.id.startswith("table-5.1/")]
     assert len(t51) == 24
-    for r in t51:  # ours from the printed theta_0, the authors' settings beside, their output
-        assert r.fields["theta0"] == -0.55 and r.authors_experiment == "table-5.1-authors" and r.authors_seeds == 2
+    tail = _tail_cell()
+    for r in t51:  # ours from the printed theta_0, the authors' settings beside (the tail cell's on its own
+        # runs: test_the_tail_cell_is_judged_on_its_larger_sample), their output
+        assert r.fields["theta0"] == -0.55 and r.authors_seeds == 2
+        assert r.authors_experiment == ("table-5.1-authors-tail" if r.id == tail else "table-5.1-authors"), r.id
         assert r.authors_output.endswith(("/99)", "/999)", "/9999)")) and r.authors_output_source.startswith(
             "lqg/results/final/rate_N")
     for rid in ("table-5.3/adaptive/upsilon", "table-5.3/adaptive/improvement-ratio"):
@@ -282,7 +285,8 @@ def test_open_rows_say_what_evidence_is_missing(rows):
 def test_authors_runs_missing_or_partial_are_shown_not_judged(store):
     root, exps, _ = store
     more = dict(exps)
-    more["table-5.1-authors"] = replace(exps["table-5.1-authors"], seeds=3)  # one seed missing
+    for n in ("table-5.1-authors", "table-5.1-authors-tail"):  # one seed missing (the tail cell falls back)
+        more[n] = replace(exps[n], seeds=3)
     rows = sc.scorecard(root, run=False, experiments=more)
     t51 = [r for r in rows if r.id.startswith("table-5.1/")]
     assert all("2 of 3 seeds: not judged" in r.authors and r.status != sc.AUTHORS_STATUS for r in t51)
@@ -511,3 +515,20 @@ def test_every_authors_curve_is_a_figure_row(rows):
         if r.judged_on == "ours":  # the 90% rule, applied to the share the row shows
             assert (r.status == "reproduced") == (r.ours_value >= sc.CURVE_SHARE), r.id
         assert "prediction band" in r.judged_interval_text or r.judged_on == "", r.id
+
+
+def _tail_cell() -> str:
+    """The id of the Table 5.1 row that table-5.1-authors-tail runs again with more seeds."""
+    tail = get_experiment("table-5.1-authors-tail").single_config()
+    return f"table-5.1/sigma={tail.sigma:g}/N={tail.method.batch_size}/alpha={tail.method.step.alpha:.0e}"
+
+
+def test_the_tail_cell_is_judged_on_its_larger_sample(store):
+    """That row's authors' column is judged on the tail's runs once all are stored, on
+    table-5.1-authors' while some are missing."""
+    root, exps, rows = store
+    tail = _tail_cell()
+    assert by_id(rows)[tail].authors_experiment == "table-5.1-authors-tail"
+    partial = sc.scorecard(root, run=False, experiments={
+        **exps, "table-5.1-authors-tail": replace(exps["table-5.1-authors-tail"], seeds=3)})
+    assert by_id(partial)[tail].authors_experiment == "table-5.1-authors"

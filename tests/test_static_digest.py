@@ -7,9 +7,9 @@ changed digest makes every page out of date.
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
+from script_module import load
 from sphinx.builders.html import BuildInfo
 from sphinx.config import Config
 
@@ -17,10 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _extension():
-    spec = importlib.util.spec_from_file_location("static_digest", ROOT / "book" / "_ext" / "static_digest.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load("book/_ext/static_digest.py")
 
 
 def test_the_digest_follows_every_file_of_the_folder(tmp_path):

@@ -15,14 +15,14 @@ from safepg.options import Batches, Departures, ErrorModel, FixedStep
 from safepg.tasks import (
     ActionDimension,
     GradientBatch,
-    GradientBatchMaxima,
+    GradientBatchConstants,
     MeasuredReturns,
     Performance,
     PerformanceBatch,
     task_hooks,
 )
 
-HOOKS = ("gradient_batch", "gradient_batch_maxima", "measured_returns", "performance", "performance_batch")
+HOOKS = ("gradient_batch", "gradient_batch_constants", "measured_returns", "performance", "performance_batch")
 ARRAYS = ("batch_size", "alpha", "coordinate", "theta", "J_hat", "grad", "eps", "safe")
 
 
@@ -98,7 +98,7 @@ def test_a_further_optional_parameter_is_allowed():
 @pytest.mark.parametrize("name,proto", [("measured_returns", "MeasuredReturns"), ("performance", "Performance"),
                                         ("gradient_batch", "GradientBatch"),
                                         ("performance_batch", "PerformanceBatch"),
-                                        ("gradient_batch_maxima", "GradientBatchMaxima")])
+                                        ("gradient_batch_constants", "GradientBatchConstants")])
 def test_a_hook_defined_without_being_declared_is_refused(name, proto):
     Undeclared = type("Undeclared", (Minimal,), {name: lambda self, *a: None})
     with pytest.raises(TypeError, match=f"defines {name} but does not declare safepg.tasks.{proto}"):
@@ -148,15 +148,15 @@ def test_a_declared_fused_batch_is_used_and_gives_the_lqgs_run():
 def test_the_maxima_hook_is_used_with_batch_constants_only():
     calls = []
 
-    class WithMaxima(Fused, GradientBatchMaxima):
-        def gradient_batch_maxima(self, policy, n, rng=None, estimator="gpomdp", baseline=True,
+    class WithConstants(Fused, GradientBatchConstants):
+        def gradient_batch_constants(self, policy, n, rng=None, estimator="gpomdp", baseline=True,
                                   score_action="clipped"):
             calls.append(n)
             samples, returns = self.lqg.gradient_batch(policy, n, rng, estimator, baseline, score_action)
             return samples, returns, (self.reward_bound, self.feature_bound)
 
-    task = WithMaxima()
-    assert hooks_of(task) == {"gradient_batch", "gradient_batch_maxima"}
+    task = WithConstants()
+    assert hooks_of(task) == {"gradient_batch", "gradient_batch_constants"}
     batch = adaptive_pg(task, 0.0, 1.0, departures=Departures(batch_constants=True), budget=2000, rng=0)
     assert calls == batch.batch_size.tolist() and task.fused == 0
     plain = adaptive_pg(task, 0.0, 1.0, budget=2000, rng=0)
@@ -231,7 +231,7 @@ def test_the_lqg_declares_its_fused_batch_and_closed_forms():
 
 def test_the_cartpole_declares_its_batches_and_measured_returns():
     for env in (CartPole.thesis(), CartPole.thesis_doubled()):
-        assert hooks_of(env) == {"gradient_batch", "gradient_batch_maxima", "measured_returns"}
+        assert hooks_of(env) == {"gradient_batch", "gradient_batch_constants", "measured_returns"}
         assert task_hooks(env).action_dim == 1
     rec = adaptive_pg(CartPole.thesis(), np.zeros(4), 1.0, batches=Batches(10, 100), budget=40, rng=0)
     assert np.all(np.isnan(rec.J)) and np.all(rec.J_hat >= 1)  # undiscounted episode lengths

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from script_module import load
 
 from safepg.envs.lqg import LQG
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
@@ -79,21 +80,21 @@ def task(**kw: Any) -> dict[str, Any]:
 #: single trajectory), a large first batch (the kernel's memory grows), other matrices, sigma
 #: and bounds, a policy that clips, and vanilla's safe step at a fixed N.
 RUNS = [
-    {"cfg": {"bound": "bernstein", "empiricalRange": True, "budget": 200_000, "seed": 1},
+    {"cfg": {"bound": "bernstein", "range": "empirical", "budget": 200_000, "seed": 1},
      "task": task(gamma=0.9, horizon=20)},
-    {"cfg": {"bound": "bernstein", "empiricalRange": True, "budget": 150_000, "seed": 2, "constants": "batch",
-             "statistics": "max", "stepWhenUnsafe": True, "nFirst": 1001},
+    {"cfg": {"bound": "bernstein", "range": "empirical", "budget": 150_000, "seed": 2, "batchConstants": True,
+             "maxima": True, "unguardedStep": True, "first": 1001},
      "task": task(gamma=0.9, horizon=20)},
     {"cfg": {"bound": "chebyshev", "budget": 120_000, "seed": 3, "nMin": 101, "delta": 0.5},
      "task": task(gamma=0.95, horizon=20)},
-    {"cfg": {"bound": "hoeffding", "empiricalRange": True, "budget": 300_000, "seed": 4, "nFirst": 150_001,
+    {"cfg": {"bound": "hoeffding", "range": "empirical", "budget": 300_000, "seed": 4, "first": 150_001,
              "nMin": 77, "sigma": 0.5},
      "task": task(gamma=0.9, horizon=15)},
-    {"cfg": {"bound": "bernstein", "empiricalRange": True, "budget": 100_000, "seed": 5, "sigma": 2.5,
+    {"cfg": {"bound": "bernstein", "range": "empirical", "budget": 100_000, "seed": 5, "sigma": 2.5,
              "theta0": [-3.0, 0.4, 0.2, -2.0]},
      "task": task(gamma=0.9, horizon=20, A=[[1.0, 0.1], [-0.2, 0.9]], B=[[0.5, 0.2], [0.0, 1.0]],
                   Q=[[1.0, 0.2], [0.2, 0.5]], R=[[0.3, 0.0], [0.0, 0.7]])},
-    {"cfg": {"algorithm": "vanilla", "batchSize": 99, "alpha": None, "step": "coordinate", "budget": 40_000,
+    {"cfg": {"method": "Vanilla", "batchSize": 99, "step": "SafeStep", "kind": "coordinate", "budget": 40_000,
              "seed": 6},
      "task": task(gamma=0.9, horizon=20)},
 ]
@@ -142,12 +143,7 @@ def test_the_shortcut_past_math_exp_answers_as_math_exp() -> None:
 
 def test_the_committed_binary_is_what_the_source_compiles_to(tmp_path: Path) -> None:
     pytest.importorskip("ziglang", reason="the kernel's compiler (requirements-dev.txt) is not installed")
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("build_wasm", ROOT / "tools" / "build_wasm.py")
-    assert spec and spec.loader
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
+    build = load("tools/build_wasm.py")
     out = tmp_path / "kernel.wasm"
     build.compile_kernel(out)
     assert out.read_bytes() == build.BINARY.read_bytes(), "run `make wasm` and commit the binary"

@@ -3,9 +3,8 @@
 ``book/api.md`` holds one fenced block ``{safepg-api}`` with a module name per line. Before
 the page is parsed, this extension replaces the block with, for each module: a heading, the
 first line of the module's docstring, an autosummary table of the module's public names and
-the full autodoc entry of each. The names are read from the module itself (its ``__all__``,
-else the public names its source defines at top level), so a name added to a module appears
-on the page without editing it, and a module is added with one line.
+the full autodoc entry of each. The names are the module's ``__all__``, so a name added
+there appears on the page without editing it, and a module is added with one line.
 
 An object that an earlier section already documents in full (``safepg.LQG`` is
 ``safepg.envs.LQG``) gets a one-line entry pointing there, which keeps the page short and
@@ -31,11 +30,10 @@ moves such an id onto the table the spec belongs to, which the HTML writes.
 
 from __future__ import annotations
 
-import ast
+import dataclasses
 import importlib
 import inspect
 import re
-from pathlib import Path
 from typing import Any
 
 from docutils import nodes
@@ -50,6 +48,10 @@ STYLE = """```{raw} html
 .bd-article table.autosummary td { white-space: normal; }
 .bd-article table.autosummary td:first-child, .bd-article table.autosummary td:first-child * {
   white-space: nowrap; overflow-wrap: normal; word-break: normal; }
+/* Signatures carry their annotations, fully qualified, and Raises names an exception by its
+   full path: on a phone they wrap inside the column. */
+.bd-article dt.sig, .bd-article dt.sig span.pre, .bd-article dl.field-list > dd {
+  white-space: normal; overflow-wrap: anywhere; }
 </style>
 ```
 """
@@ -81,7 +83,7 @@ def block_modules(text: str) -> list[str]:
 
 
 def public_names(modname: str) -> list[str]:
-    """The public names of a module: its ``__all__``, else what its source defines.
+    """The public names of a module: its ``__all__``, in its order.
 
     Parameters
     ----------
@@ -91,36 +93,17 @@ def public_names(modname: str) -> list[str]:
     Returns
     -------
     list of str
-        ``__all__`` in its order when the module has one; otherwise the classes, functions
-        and assigned names its source defines at top level, in source order, without those
-        starting with an underscore (imported names are not the module's own).
+        ``__all__`` without what the import did not define (an optional dependency missing).
+
+    Raises
+    ------
+    ValueError
+        The module has no ``__all__``: what it exports must be said there, not guessed.
     """
     module = importlib.import_module(modname)
-    if hasattr(module, "__all__"):
-        return list(module.__all__)
-    tree = ast.parse(Path(inspect.getsourcefile(module)).read_text(encoding="utf-8"))
-    names: list[str] = []
-
-    def scan(body: list[ast.stmt]) -> None:
-        for node in body:
-            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
-                found = [node.name]
-            elif isinstance(node, ast.Assign):
-                found = [t.id for t in node.targets if isinstance(t, ast.Name)]
-            elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
-                found = [node.target.id]
-            elif isinstance(node, ast.If | ast.Try):
-                # Definitions that depend on an optional dependency (``try: import gymnasium``).
-                for part in (node.body, node.orelse, getattr(node, "finalbody", [])):
-                    scan(part)
-                found = []
-            else:
-                found = []
-            names.extend(n for n in found if not n.startswith("_") and n not in names)
-
-    scan(tree.body)
-    # What the import did not define (an optional dependency is missing) is not listed.
-    return [n for n in names if hasattr(module, n)]
+    if not hasattr(module, "__all__"):
+        raise ValueError(f"{modname} must define __all__ to be on the API page")
+    return [n for n in module.__all__ if hasattr(module, n)]
 
 
 def _kind(obj: Any) -> str:
@@ -277,6 +260,21 @@ def _docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: li
     lines[:] = plain_bars(lines)
 
 
+def _signature(app: Any, what: str, name: str, obj: Any, options: Any, signature: str | None,
+               return_annotation: str | None) -> tuple[str | None, str | None] | None:
+    """A dataclass's signature with each ``<factory>`` default written as the value it makes.
+
+    ``<factory>`` is not Python: Sphinx would then give up parsing the signature and split it
+    at every comma, annotations included (``Literal['scalar', 'coordinate']``).
+    """
+    if not signature or "<factory>" not in signature or not dataclasses.is_dataclass(obj):
+        return None
+    for f in dataclasses.fields(obj):
+        if f.init and f.default_factory is not dataclasses.MISSING:
+            signature = signature.replace("<factory>", repr(f.default_factory()), 1)
+    return signature, return_annotation
+
+
 def _source_read(app: Any, docname: str, source: list[str]) -> None:
     if "{safepg-api}" in source[0]:
         pointers: set[str] = set()
@@ -343,7 +341,8 @@ def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
         name = documented.get(id(_identity(obj)))
         if name is not None:
             py = env.get_domain("py")
-            return py.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], name, node, contnode)
+            # "obj" matches any kind: an annotation's type alias (RNGLike) is documented as data.
+            return py.resolve_xref(env, node["refdoc"], app.builder, "obj", name, node, contnode)
     return None
 
 
@@ -380,7 +379,9 @@ def setup(app: Any) -> dict[str, Any]:
     # Before numpydoc (priority 500) turns the sections into reStructuredText.
     app.connect("autodoc-process-docstring", _docstring, priority=400)
     app.connect("missing-reference", _missing_reference)
+    app.connect("autodoc-process-signature", _signature)
     app.add_transform(KeepTargetIds)
-    # Doctrees read before KeepTargetIds existed lack the module ids: a new env_version has
-    # Sphinx read every page again instead of reusing them.
-    return {"parallel_read_safe": True, "parallel_write_safe": True, "env_version": 1}
+    # A change to what the expansion writes (KeepTargetIds' module ids, the signatures' style)
+    # is not a change to book/api.md: a new env_version has Sphinx read every page again
+    # instead of reusing the old doctrees.
+    return {"parallel_read_safe": True, "parallel_write_safe": True, "env_version": 3}

@@ -69,7 +69,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, GradientBatch, GradientBatchMaxima, MeasuredReturns
+from safepg.tasks import ActionDimension, GradientBatch, GradientBatchConstants, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -189,7 +189,7 @@ def _check_integrator(integrator: str) -> None:
 
 
 @dataclass(frozen=True)
-class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimension):
+class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension):
     r"""The continuous cart-pole task of Section 5.3, simulated N carts at a time.
 
     Parameters
@@ -396,7 +396,8 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
     def alive(self, state: np.ndarray) -> np.ndarray:
         """Whether states (..., 4) are inside the thresholds (|x| <= 2.4, |beta| <= 41.8 deg)."""
         s = np.asarray(state, dtype=float)
-        return (np.abs(s[..., 0]) <= self.x_threshold) & (np.abs(s[..., 2]) <= self.angle_threshold)
+        inside: np.ndarray = (np.abs(s[..., 0]) <= self.x_threshold) & (np.abs(s[..., 2]) <= self.angle_threshold)
+        return inside
 
     # ----------------------------------------------------------------- simulator
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
@@ -521,7 +522,7 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
         samples, returns, _ = self._fused_batch(policy, n, rng, estimator, baseline, score_action, peaks=False)
         return samples, returns
 
-    def gradient_batch_maxima(
+    def gradient_batch_constants(
         self,
         policy: LinearGaussianPolicy,
         n: int,
@@ -551,9 +552,9 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
         return samples, returns, (1.0, float(peak.max()))
 
     def _fused_batch(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike, estimator: str, baseline: bool,
-                     score_action: str, peaks: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+                     score_action: str, peaks: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The fused kernel on a fresh batch: samples, undiscounted returns and (with ``peaks``) each
-        trajectory's largest |state component| (else None)."""
+        trajectory's largest |state component| (else an empty array)."""
         from safepg.envs._cartpole_kernel import cartpole_gradient_samples
 
         n = self._check_policy_and_n(policy, n)
@@ -577,7 +578,7 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
         samples, returns = out[0], out[1]
         if self.feature_scale is not None:
             samples /= scale
-        return samples, returns, out[2] if peaks else None
+        return samples, returns, out[2] if peaks else np.empty(0)
 
     def simulate_gain(self, gain: np.ndarray, sigma: float | np.ndarray, n: int,
                       rng: RNGLike = None) -> Trajectories:
@@ -609,7 +610,8 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
 
         This is the performance the thesis reports for the cart-pole (at most H = 200).
         """
-        return batch.rewards.sum(axis=1)
+        lengths: np.ndarray = batch.rewards.sum(axis=1)
+        return lengths
 
     def measured_returns(self, batch: Trajectories) -> np.ndarray:
         """The per-trajectory performance the learning loop records (J_hat), shape (N,).
@@ -627,11 +629,13 @@ class CartPole(GradientBatch, GradientBatchMaxima, MeasuredReturns, ActionDimens
 try:
     import gymnasium as _gym
     from gymnasium import spaces as _spaces
+
+    _HAVE_GYMNASIUM = True
 except ImportError:  # pragma: no cover - exercised only without gymnasium
-    _gym = None
+    _HAVE_GYMNASIUM = False
 
 
-if _gym is not None:
+if _HAVE_GYMNASIUM:
 
     class ContinuousCartPoleEnv(_gym.Env):
         """Single cart-pole as a gymnasium environment, the same task as :class:`CartPole`.
@@ -656,7 +660,7 @@ if _gym is not None:
         draw (used to replay the batched simulator's initial states).
         """
 
-        metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+        metadata: dict[str, Any] = {"render_modes": []}  # gymnasium.Env's class attribute
 
         def __init__(self, render_mode: str | None = None, **task: Any) -> None:
             if render_mode is not None:
@@ -767,3 +771,7 @@ else:  # pragma: no cover
 
     def register_envs() -> None:
         """No-op without gymnasium (an optional dependency)."""
+
+
+__all__ = ["CartPole", "ContinuousCartPoleEnv", "ENV_ID", "INTEGRATORS", "NORMALISED_SCALE", "gymnasium_step",
+           "register_envs", "step_dynamics"]

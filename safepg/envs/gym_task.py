@@ -54,6 +54,11 @@ def with_bias(obs: np.ndarray) -> np.ndarray:
     return np.concatenate([obs, np.ones(obs.shape[:-1] + (1,))], axis=-1)
 
 
+def _returning(env: gymnasium.Env) -> Callable[[], gymnasium.Env]:
+    """A factory of ``env`` itself: the vector env steps the pool's environments, not copies."""
+    return lambda: env
+
+
 def _check_positive(name: str, value: float | None) -> float | None:
     if value is None:
         return None
@@ -131,13 +136,18 @@ class GymTask(MeasuredReturns, ActionDimension):
     reset_options : dict, optional
         ``options`` of every episode's ``reset`` (e.g. Pendulum-v1's
         ``{"x_init": 0.3, "y_init": 0.3}``, the half-widths of its initial angle and speed).
+    name, features_name : str, optional
+        The names a factory ``env`` and the feature map enter a stored run's definition by
+        (:meth:`definition`). A function defined at the top of a module needs none (its
+        ``module:qualname`` is its name); a lambda or a nested function does, and its name
+        must change whenever the function does: the stored runs are found by it.
 
     Raises
     ------
     ValueError
-        At construction: ``horizon`` or ``gamma`` missing or invalid (simulation needs
-        them), a given constant not finite and > 0, non-Box spaces, or a feature map
-        that does not return (N, d_phi). When a bound constant is read (the learning loops
+        At construction: ``horizon`` or ``gamma`` invalid (simulation needs them), a given
+        constant not finite and > 0, non-Box spaces, or a feature map that does not return
+        (N, d_phi). When a bound constant is read (the learning loops
         read all of them when they start, see below): ``"reward_bound must be given: ..."``
         and likewise ``feature_bound``, and ``action_volume`` / ``action_bound`` when the
         action Box is unbounded.
@@ -170,8 +180,8 @@ class GymTask(MeasuredReturns, ActionDimension):
         self,
         env: str | Callable[[], gymnasium.Env],
         *,
-        horizon: int | None = None,
-        gamma: float | None = None,
+        horizon: int,
+        gamma: float,
         reward_bound: float | None = None,
         feature_bound: float | None = None,
         action_volume: float | None = None,
@@ -181,19 +191,17 @@ class GymTask(MeasuredReturns, ActionDimension):
         measure: Literal["discounted", "undiscounted"] = "discounted",
         env_kwargs: dict[str, Any] | None = None,
         reset_options: dict[str, Any] | None = None,
+        name: str | None = None,
+        features_name: str | None = None,
     ) -> None:
         try:
             from gymnasium import spaces
         except ImportError as exc:  # pragma: no cover - only without the optional dependency
             raise ImportError("GymTask needs gymnasium: pip install 'safepg[gym]'") from exc
 
-        if horizon is None:
-            raise ValueError("horizon must be given: the number of steps H after which every episode is cut")
-        if isinstance(horizon, bool) or int(horizon) != horizon or horizon < 1:
+        if isinstance(horizon, bool) or not isinstance(horizon, int | np.integer) or horizon < 1:
             raise ValueError(f"horizon must be a positive integer, got {horizon!r}")
-        if gamma is None:
-            raise ValueError("gamma must be given: the discount factor in (0, 1] of the returns")
-        if not 0 < gamma <= 1:
+        if isinstance(gamma, bool) or not isinstance(gamma, int | float | np.floating) or not 0 < gamma <= 1:
             raise ValueError(f"gamma must be in (0, 1], got {gamma!r}")
         if horizon_term not in HORIZON_TERMS:
             raise ValueError(f"horizon_term must be one of {HORIZON_TERMS}, got {horizon_term!r}")
@@ -212,28 +220,31 @@ class GymTask(MeasuredReturns, ActionDimension):
         if isinstance(env, str):
             self.env_id: str | None = env
             self.env_kwargs = {"max_episode_steps": self.horizon, **(env_kwargs or {})}
-            self._factory: Callable[[], gymnasium.Env] | None = None
         elif callable(env):
             if env_kwargs:
                 raise ValueError("env_kwargs must be None with an environment factory (pass them to the factory)")
-            self.env_id, self.env_kwargs, self._factory = None, {}, env
+            self.env_id, self.env_kwargs = None, {}
         else:
             raise ValueError(f"env must be a gymnasium id or a factory of environments, got {env!r}")
+        self._source = env
+        self.name = name
+        self.features_name = features_name
         self._env_name = env if isinstance(env, str) else getattr(env, "__qualname__", repr(env))
 
         first = self._make()
         self._pool: list[gymnasium.Env] = [first]
         obs_space, act_space = first.observation_space, first.action_space
-        for name, space in (("observation_space", obs_space), ("action_space", act_space)):
-            if not isinstance(space, spaces.Box):
-                first.close()
-                raise ValueError(f"{name} must be a gymnasium Box, got {space!r}")
-        self.observation_space = obs_space
-        self.action_space = act_space
-        self.obs_dim = int(np.prod(obs_space.shape))
-        self.action_dim = int(np.prod(act_space.shape))
-        self._low = np.asarray(act_space.low, dtype=float).reshape(-1)
-        self._high = np.asarray(act_space.high, dtype=float).reshape(-1)
+        if not isinstance(obs_space, spaces.Box) or not isinstance(act_space, spaces.Box):
+            first.close()
+            name, space = ("observation_space", obs_space) if not isinstance(obs_space, spaces.Box) else (
+                "action_space", act_space)
+            raise ValueError(f"{name} must be a gymnasium Box, got {space!r}")
+        self.observation_space: spaces.Box = obs_space
+        self.action_space: spaces.Box = act_space
+        self.obs_dim = math.prod(obs_space.shape)
+        self._action_dim = math.prod(act_space.shape)
+        self._low = np.asarray(act_space.low, dtype=np.float64).reshape(-1)
+        self._high = np.asarray(act_space.high, dtype=np.float64).reshape(-1)
         self._bounded = bool(np.all(np.isfinite(self._low)) and np.all(np.isfinite(self._high)))
 
         self._features = features
@@ -244,11 +255,16 @@ class GymTask(MeasuredReturns, ActionDimension):
 
     def _make(self) -> gymnasium.Env:
         """A fresh environment."""
-        if self._factory is not None:
-            return self._factory()
+        if not isinstance(self._source, str):
+            return self._source()
         import gymnasium
 
-        return gymnasium.make(self.env_id, **self.env_kwargs)
+        return gymnasium.make(self._source, **self.env_kwargs)
+
+    @property
+    def action_dim(self) -> int:
+        """d_a, the number of components of the action Box."""
+        return self._action_dim
 
     # ------------------------------------------------------------ bound constants
     @property
@@ -306,7 +322,7 @@ class GymTask(MeasuredReturns, ActionDimension):
             self._pool.append(self._make())
         # NEXT_STEP autoreset: a sub-env whose episode ended is reset on the following step;
         # those steps are dead (masked) anyway.
-        self._vec = SyncVectorEnv([(lambda e=e: e) for e in self._pool[:n]], copy=False,
+        self._vec = SyncVectorEnv([_returning(e) for e in self._pool[:n]], copy=False,
                                   autoreset_mode=AutoresetMode.NEXT_STEP)
         return self._vec
 
@@ -379,7 +395,8 @@ class GymTask(MeasuredReturns, ActionDimension):
         The discounted return, or the sum of rewards with ``measure="undiscounted"``.
         """
         if self.measure == "undiscounted":
-            return batch.rewards.sum(axis=1)
+            lengths: np.ndarray = batch.rewards.sum(axis=1)
+            return lengths
         return batch.discounted_returns()
 
     # --------------------------------------------------------------------- misc
@@ -389,6 +406,42 @@ class GymTask(MeasuredReturns, ActionDimension):
             e.close()
         self._pool = []
         self._vec = None
+
+    def definition(self) -> dict[str, Any]:
+        """The keyword arguments that make this task again: what a stored run's key hashes.
+
+        An id enters as ``env``, a factory as ``env_factory``: its ``name``, else its
+        ``module:qualname``; the feature map likewise (``features_name``).
+
+        Raises
+        ------
+        safepg.definition.UnnamedError
+            The factory or the feature map is a lambda or a nested function without a name.
+        """
+        from safepg.definition import function_name
+
+        source: dict[str, Any]
+        if isinstance(self._source, str):
+            kwargs = {k: v for k, v in self.env_kwargs.items() if k != "max_episode_steps" or v != self.horizon}
+            source = {"env": self._source, "env_kwargs": kwargs or None}
+        else:
+            source = {"env_factory": self.name or function_name(self._source)}
+        features = None if self._features is None else self.features_name or function_name(self._features)
+        return {**source, "horizon": self.horizon, "gamma": self.gamma, "reward_bound": self._reward_bound,
+                "feature_bound": self._feature_bound, "action_volume": self._action_volume,
+                "action_bound": self._action_bound, "features": features, "horizon_term": self.horizon_term,
+                "measure": self.measure, "reset_options": self.reset_options}
+
+    @classmethod
+    def from_definition(cls, *, env: str | None = None, env_factory: str | None = None, features: str | None = None,
+                        **kwargs: Any) -> GymTask:
+        """The task :meth:`definition` describes (factories and feature maps imported by name)."""
+        from safepg.definition import import_name
+
+        if (env is None) == (env_factory is None):
+            raise ValueError("exactly one of env and env_factory must be given")
+        source = env if env is not None else import_name(str(env_factory))
+        return cls(source, features=None if features is None else import_name(features), **kwargs)
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle without the environments (for process pools); they are made again on use."""

@@ -18,6 +18,7 @@ performance". They are not the objective the clipped, H-step simulator optimises
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numba
 import numpy as np
@@ -95,16 +96,23 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
         mats = tuple(_as_matrix(getattr(self, k), self.dim, k) for k in "ABQR")
         object.__setattr__(self, "_mats", mats)
 
+    def definition(self) -> dict[str, Any]:
+        """The fields that make this task, each matrix written out (``A=1.0`` and ``A=[[1.0]]``
+        are one task): what a stored run's key hashes (:mod:`safepg.definition`)."""
+        A, B, Q, R = self._mats
+        return {"dim": self.dim, "gamma": self.gamma, "horizon": self.horizon, "state_bound": self.state_bound,
+                "action_bound": self.action_bound, "A": A, "B": B, "Q": Q, "R": R, "clip": self.clip}
+
     # ------------------------------------------------------------------ settings
     @classmethod
-    def thesis_1d(cls, **overrides: object) -> LQG:
+    def thesis_1d(cls, **overrides: Any) -> LQG:
         """The one-dimensional task of Section 5.1 with the settings of SETTINGS.md."""
-        return cls(**{"dim": 1, "gamma": 0.9, "horizon": 20, **overrides})  # type: ignore[arg-type]
+        return cls(**{"dim": 1, "gamma": 0.9, "horizon": 20, **overrides})
 
     @classmethod
-    def thesis_2d(cls, **overrides: object) -> LQG:
+    def thesis_2d(cls, **overrides: Any) -> LQG:
         """The two-dimensional task of Section 5.2.1 as printed (Q = R = I, gamma = 0.95)."""
-        return cls(**{"dim": 2, "gamma": 0.95, "horizon": 20, **overrides})  # type: ignore[arg-type]
+        return cls(**{"dim": 2, "gamma": 0.95, "horizon": 20, **overrides})
 
     # ------------------------------------------------------------ bound constants
     @property
@@ -127,7 +135,7 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
 
     # ----------------------------------------------------------------- simulator
     @property
-    def action_dim(self) -> int:  # type: ignore[override]
+    def action_dim(self) -> int:
         """Actions have as many components as states (``dim``)."""
         return self.dim
 
@@ -196,7 +204,8 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
             # LAPACK's eigenvalues may differ across CPUs in the last bit; only the yes/no
             # answer is used, and it could flip only for a gain exactly on the boundary.
             radius = np.max(np.abs(np.linalg.eigvals(F)), axis=1)
-        return radius * np.sqrt(self.gamma) < 1
+        stable: np.ndarray = radius * np.sqrt(self.gamma) < 1
+        return stable
 
     def _lyapunov(self, F: np.ndarray, M: np.ndarray) -> np.ndarray:
         r"""P solving :math:`P = M + \gamma F^\top P F` for a batch (I, m, m) of F and M.
@@ -228,7 +237,8 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
         K = self._gain(theta)
         if not self.is_stable(K):
             raise ValueError("theta makes the closed loop unstable: J(theta) = -inf")
-        return self._value_matrices(K[None])[0]
+        P: np.ndarray = self._value_matrices(K[None])[0]
+        return P
 
     def performance(self, theta: np.ndarray | float, sigma: float | np.ndarray) -> float:
         r"""Closed-form expected performance J(theta) (infinite horizon, no clipping).
@@ -353,13 +363,19 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
                  score_action == "clipped", estimator == "reinforce", bool(baseline))
         # One chunk, or one thread (a campaign's worker): the serial build, the same numbers.
         serial = n <= kernels.CHUNK or numba.get_num_threads() == 1
+        out: tuple[np.ndarray, np.ndarray]  # (samples, returns)
         if self.dim == 1:
             kernel = kernels.lqg1d_gradient_samples_serial if serial else kernels.lqg1d_gradient_samples
-            return kernel(float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
-                          float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
+            out = kernel(float(policy.gain[0, 0]), float(policy.cov_chol[0, 0]),
+                         float(A[0, 0]), float(B[0, 0]), float(Q[0, 0]), float(R[0, 0]), *head, *flags)
+            return out
         # m = 2 (Section 5.2) has its own unrolled kernel; m >= 3 uses the generic loops.
         if self.dim == 2:
             kernel = kernels.lqg2d_gradient_samples_serial if serial else kernels.lqg2d_gradient_samples
         else:
             kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
-        return kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        out = kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        return out
+
+
+__all__ = ["LQG"]

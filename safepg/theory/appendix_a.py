@@ -117,3 +117,6 @@ def gaussian_kl() -> dict[str, sp.Expr]:
         ``kl``, ``two_kl``.
     """
     return dict(_gaussian_kl())
+
+
+__all__ = ["gaussian_density_hessian", "gaussian_kl", "taylor_remainder_weights"]

@@ -59,3 +59,6 @@ def corollary_b_0_7() -> dict[str, sp.Expr]:
         (:math:`(g-b)^2/(4c)`), and the printed versions.
     """
     return dict(_corollary_b_0_7())
+
+
+__all__ = ["corollary_b_0_7", "softmax_constants"]

@@ -396,3 +396,8 @@ def bernstein_root_beyond_n_zero() -> dict[str, sp.Expr]:
     x0 = sp.Symbol("x_0", positive=True)
     at_x0 = sp.expand(sp.simplify(second.subs(x, x0).subs(g, (d * x0 + f) / x0**2)))
     return {"second_factor_at_x0": at_x0, "is_positive": sp.true if at_x0.is_positive else sp.false}
+
+
+__all__ = ["bernstein_derivative_factors", "bernstein_descartes", "bernstein_n_zero", "bernstein_root_beyond_n_zero",
+           "bernstein_upsilon", "bernstein_upsilon_derivative", "chebyshev_d", "chebyshev_n_star",
+           "descartes_sign_changes", "gradient_range_bound", "hoeffding_d", "theorem_4_3_2", "upsilon"]

@@ -293,3 +293,8 @@ def scalar_step_comparison() -> dict[str, sp.Expr]:
         "ratio_improvement_3_3_2": sp.simplify(imp332 / derived_improvement),
         "ratio_5_2_1": sp.simplify(p521 / derived_alpha),
     }
+
+
+__all__ = ["coordinate_descent_reduction", "corollary_4_2_4", "corollary_4_2_5", "corollary_4_2_8",
+           "improvement_bound_approx", "improvement_bound_coordinate", "norm_inequality", "penalty_constant",
+           "penalty_constant_derivation", "scalar_step_bound", "scalar_step_comparison"]

@@ -77,7 +77,8 @@ def latex(expr: sp.Basic | str, **kwargs: object) -> str:
     """
     if isinstance(expr, str):
         return expr
-    return sp.latex(expr, symbol_names=LATEX_NAMES, **kwargs)
+    text: str = sp.latex(expr, symbol_names=LATEX_NAMES, **kwargs)
+    return text
 
 
 def tidy(expr: sp.Expr) -> sp.Expr:
@@ -87,7 +88,7 @@ def tidy(expr: sp.Expr) -> sp.Expr:
 
 def is_zero(expr: sp.Expr) -> bool:
     """Whether ``expr`` simplifies to 0 (exact comparison of two derivations by their difference)."""
-    return sp.simplify(expr) == 0
+    return bool(sp.simplify(expr) == 0)
 
 
 def maximise(bound: sp.Expr, var: sp.Symbol = alpha) -> tuple[sp.Expr, sp.Expr]:
@@ -110,3 +111,7 @@ def maximise(bound: sp.Expr, var: sp.Symbol = alpha) -> tuple[sp.Expr, sp.Expr]:
         raise ValueError(f"bound must have exactly one provable maximiser in {var}, got {points}")
     arg = sp.factor(sp.simplify(points[0]))
     return arg, sp.factor(sp.simplify(bound.subs(var, arg)))
+
+
+__all__ = ["A_bar", "A_vol", "H", "LATEX_NAMES", "M_phi", "N", "R", "R_range", "S_N", "alpha", "b", "c", "d", "delta",
+           "eps", "f", "g", "g1", "g2", "gamma", "is_zero", "latex", "maximise", "mu_bar", "sigma", "tidy", "var", "x"]

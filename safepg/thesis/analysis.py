@@ -14,34 +14,6 @@ from safepg.learning import LearningRecord
 from safepg.thesis.authors import strict_improvement_ratio
 
 
-def performance_on_grid(records: Sequence[LearningRecord], grid: np.ndarray) -> np.ndarray:
-    """J of the policy that generated trajectory T, for T in ``grid`` (1-based), per seed.
-
-    This is the thesis's "expected performance over sample trajectories": each
-    iteration's J is held for all the trajectories of its batch (Figures 5.1, 5.2).
-    Returns an array (seeds, len(grid)); NaN past a run's last trajectory.
-    """
-    grid = np.asarray(grid)
-    out = np.full((len(records), grid.size), np.nan)
-    for i, r in enumerate(records):
-        ends = np.cumsum(r.batch_size)
-        idx = np.searchsorted(ends, grid)
-        ok = idx < r.iterations
-        out[i, ok] = r.J[idx[ok]]
-    return out
-
-
-def measured_on_grid(records: Sequence[LearningRecord], grid: np.ndarray) -> np.ndarray:
-    """Batch-average return of the batch containing trajectory T (Figure 5.9's curve)."""
-    grid = np.asarray(grid)
-    out = np.full((len(records), grid.size), np.nan)
-    for i, r in enumerate(records):
-        idx = np.searchsorted(np.cumsum(r.batch_size), grid)
-        ok = idx < r.iterations
-        out[i, ok] = r.J_hat[idx[ok]]
-    return out
-
-
 def by_iteration(records: Sequence[LearningRecord], field: str = "batch_size") -> np.ndarray:
     """A per-iteration field (e.g. batch size, step size) per seed, NaN-padded: (seeds, max I)."""
     length = max(r.iterations for r in records)
@@ -63,12 +35,23 @@ def compare(ours: float | None, thesis: float | None) -> dict[str, Any]:
     return {"ours": ours, "thesis": thesis, "difference": diff}
 
 
+def method_columns(method: dict[str, Any]) -> dict[str, Any]:
+    """The thesis's table columns of a method written as data (:func:`safepg.definition.to_dict`):
+    ``estimator``, ``bound``, ``empirical_range`` (its "e.r."), ``delta``, and the fixed
+    ``batch_size`` and ``alpha`` (None for Algorithm 4.1 or a safe step)."""
+    step = method.get("step") or {}
+    error = method.get("error") or step.get("error") or {}
+    return {"estimator": method["gradient"]["estimator"], "bound": error.get("bound"),
+            "empirical_range": error.get("range") == "empirical", "delta": error.get("delta"),
+            "batch_size": method.get("batch_size"), "alpha": step.get("alpha")}
+
+
 def table_5_1(report: dict[str, Any]) -> list[dict[str, Any]]:
     """Rows of Table 5.1: improvement ratio by sigma, N, alpha, ours beside the thesis's."""
     rows = []
     for c in report["configs"]:
-        ir = c["improvement_ratio"]
-        rows.append({"sigma": c["sigma"], "N": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+        ir, m = c["improvement_ratio"], method_columns(c["method"])
+        rows.append({"sigma": c["sigma"], "N": m["batch_size"], "alpha": m["alpha"], "seeds": c["seeds"],
                      "diverged": c.get("diverged", 0),
                      "ci95": ir["ci95"], **compare(ir["mean"], (c["thesis"] or {}).get("improvement_ratio"))})
     return rows
@@ -78,9 +61,9 @@ def table_5_2(report: dict[str, Any]) -> list[dict[str, Any]]:
     """Rows of Table 5.2: average performance with 95% CI, ours beside the thesis's."""
     rows = []
     for c in report["configs"]:
-        ub, th = c["upsilon_bar"], c["thesis"] or {}
-        rows.append({"estimator": c["estimator"], "bound": c["bound"], "empirical_range": c["empirical_range"],
-                     "delta": c["delta"], "seeds": c["seeds"], "ci95": ub["ci95"], "thesis_ci95": th.get("ci95"),
+        ub, th, m = c["upsilon_bar"], c["thesis"] or {}, method_columns(c["method"])
+        rows.append({"estimator": m["estimator"], "bound": m["bound"], "empirical_range": m["empirical_range"],
+                     "delta": m["delta"], "seeds": c["seeds"], "ci95": ub["ci95"], "thesis_ci95": th.get("ci95"),
                      "improvement_ratio": c["improvement_ratio"]["mean"],
                      **compare(ub["mean"], th.get("upsilon_bar"))})
     return rows
@@ -92,9 +75,10 @@ def table_upsilon(report: dict[str, Any]) -> list[dict[str, Any]]:
     rows = []
     for c in report["configs"]:
         ub, ir, th = c["upsilon_bar"], c["improvement_ratio"], c["thesis"] or {}
+        m = method_columns(c["method"])
         up = compare(ub["mean"], th.get("upsilon_bar"))
         imp = compare(ir["mean"], th.get("improvement_ratio"))
-        rows.append({"name": c["name"], "batch_size": c["batch_size"], "alpha": c["alpha"], "seeds": c["seeds"],
+        rows.append({"name": c["name"], "batch_size": m["batch_size"], "alpha": m["alpha"], "seeds": c["seeds"],
                      "upsilon_bar": up["ours"], "upsilon_ci95": ub["ci95"], "thesis_upsilon_bar": up["thesis"],
                      "upsilon_difference": up["difference"],
                      "improvement_ratio": imp["ours"], "improvement_ci95": ir["ci95"],
@@ -243,7 +227,7 @@ def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequen
     and the estimators share each batch's random numbers."""
     from safepg.policies import LinearGaussianPolicy
 
-    pol = LinearGaussianPolicy([[theta]], sigma)
+    pol = LinearGaussianPolicy(np.array([[theta]]), sigma)
     rng = np.random.default_rng(seed)
     out = {e: np.empty((len(batch_sizes), repeats)) for e in estimators}
     for i, n in enumerate(batch_sizes):
@@ -255,7 +239,7 @@ def gradient_estimates(env: Any, theta: float, sigma: float, batch_sizes: Sequen
     return out
 
 
-def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, seed: int = 0,
+def sample_variance(env: Any, theta: float, sigmas: Sequence[float] | np.ndarray, n: int, seed: int = 0,
                     estimators: Sequence[str] = ("reinforce", "gpomdp"),
                     baseline: bool = True) -> dict[str, np.ndarray]:
     """Per-trajectory variance of each estimator's gradient sample as sigma varies (1-D)."""
@@ -263,7 +247,7 @@ def sample_variance(env: Any, theta: float, sigmas: Sequence[float], n: int, see
 
     out = {e: np.empty(len(sigmas)) for e in estimators}
     for i, s in enumerate(sigmas):
-        pol = LinearGaussianPolicy([[theta]], s)
+        pol = LinearGaussianPolicy(np.array([[theta]]), s)
         for e in estimators:
             out[e][i] = env.gradient_batch(pol, n, np.random.default_rng(seed), e, baseline)[0].var(ddof=1)
     return out

@@ -23,7 +23,7 @@ from safepg.envs.cartpole import CartPole
 from safepg.runner import RESULTS_VERSION, TIMING_FILE
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiment_store import experiment_folder, load_experiment
-from safepg.thesis.experiments import get_experiment, make_env
+from safepg.thesis.experiments import get_experiment
 
 #: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
 CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
@@ -84,7 +84,7 @@ def experiment_work(name: str, chapter: str, root: Path) -> Work:
     recs = load_experiment(exp, root)
     traj = steps = normals = uniforms = 0
     for cfg in exp.configs:
-        env = make_env(cfg.env)
+        env = cfg.make_task()
         for rec in recs.get(cfg.name, []):
             n = int(rec.batch_size.sum())
             traj += n

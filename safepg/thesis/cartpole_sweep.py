@@ -210,7 +210,7 @@ def sweep_table(runs: dict[str, Any]) -> list[dict[str, Any]]:
         if st.doubled:
             vkey = f"{st.key}:N=4000" if f"{st.key}:N=4000" in names else "thesis:N=4000"
             for method, name in (("adaptive", f"{st.key}:adaptive"), ("vanilla", vkey)):
-                summary = _method_summary(runs["sweep"].get(name, []), make_env(exp.config(name).env))
+                summary = _method_summary(runs["sweep"].get(name, []), exp.config(name).make_task())
                 row.update({f"{method}_{k}": v for k, v in summary.items()})
             ok = row["adaptive_seeds"] and row["vanilla_seeds"]
             row["adaptive_learns"] = bool(ok and row["adaptive_gain"] > LEARNS_MARGIN)

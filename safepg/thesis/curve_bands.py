@@ -39,11 +39,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from safepg.learning import LearningRecord
+from safepg.options import Adaptive
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, overlays
 from safepg.thesis.analysis import by_iteration
 from safepg.thesis.authors import TABLE_5_4_BUDGET, AuthorsRun
-from safepg.thesis.experiments import get_experiment
+from safepg.thesis.experiments import get_experiment, method_of
 
 #: The scorecard's rule: a curve is reproduced when at least this share of it lies in our band.
 CURVE_SHARE = 0.9
@@ -330,8 +331,9 @@ def figures51_52_spread(records: Records) -> list[dict[str, Any]]:
         found = figures51_52_authors_runs(records, cfg.name)
         if found is None:
             continue
-        error = cfg.method.error
-        key = (cfg.method.gradient.estimator, error.bound, error.empirical_range, error.delta)
+        method = method_of(cfg, Adaptive)
+        error = method.error
+        key = (method.gradient.estimator, error.bound, error.empirical_range, error.delta)
         s = overlays.figure51_52_overlay_series({cfg.name: found[1]}, cfg, "authors")
         mapped = [authors.grid_curve(r["N"], r["J"])[1] for r in runs52[key]]
         theirs = [band_share(s["x"], z, s["values"], 1, rounding=written_rounding(z, digits=RUN_DIGITS))["share_inside"]
@@ -357,7 +359,8 @@ def _lqg1d_scores(records: Records) -> list[CurveScore]:
             name, mine = theirs
             scores.append(figures51_52_score({cfg.name: mine}, get_experiment(name).config(cfg.name), name,
                                              "authors"))
-        estimator, error = cfg.method.gradient.estimator, cfg.method.error
+        method = method_of(cfg, Adaptive)
+        estimator, error = method.gradient.estimator, method.error
         if not (recs.get(cfg.name) and estimator == "gpomdp" and error.delta == 0.95):
             continue
         key = (estimator, error.bound, error.empirical_range, error.delta)

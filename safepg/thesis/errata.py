@@ -535,3 +535,5 @@ def __getattr__(name: str) -> object:
         return errata()
     if name == "VERIFIED":
         return verified()
+    # Any other name reads as None, as it always has (not an AttributeError).
+    return None

@@ -14,12 +14,13 @@ from __future__ import annotations
 
 from dataclasses import KW_ONLY, dataclass, field, replace
 from functools import partial
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from safepg.bounds import Range
+from safepg.bounds import Bound, Range
 from safepg.envs.lqg import LQG
+from safepg.estimators import Estimator
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.runner import RunConfig
 from safepg.runner import make_env as make_core_env
@@ -32,6 +33,8 @@ from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BASELINE_CAP, SWE
 LQG2D_GAMMA = 0.9
 #: Tasks of the reproduction beyond the core's named ones, by the name their runs are keyed on.
 THESIS_ENVS = {"lqg2d-gamma0.9": partial(LQG.thesis_2d, gamma=LQG2D_GAMMA)}
+#: That task, as the Section 5.2 configurations hold it.
+LQG2D_TASK = THESIS_ENVS["lqg2d-gamma0.9"]()
 
 
 def make_env(name: str) -> Any:
@@ -82,6 +85,29 @@ class Experiment:
         return self.configs[0]
 
 
+_M = TypeVar("_M", Adaptive, Vanilla)
+
+
+def method_of(config: RunConfig, kind: type[_M]) -> _M:
+    """``config``'s method, of the kind the caller knows it to be (to read or change the options only
+    that kind has).
+
+    Parameters
+    ----------
+    config : RunConfig
+    kind : {Adaptive, Vanilla}
+        The class of the method ``config`` runs.
+
+    Raises
+    ------
+    TypeError
+        If ``config`` runs the other kind of method.
+    """
+    if not isinstance(config.method, kind):
+        raise TypeError(f"config {config.name!r} must run a {kind.__name__} method, got {config.method!r}")
+    return config.method
+
+
 def _with_gradient(method: Adaptive | Vanilla, **changes: Any) -> Adaptive | Vanilla:
     """``method`` with fields of its :class:`~safepg.options.Gradient` changed."""
     return replace(method, gradient=replace(method.gradient, **changes))
@@ -100,7 +126,7 @@ BERNSTEIN_ER = ErrorModel("bernstein", 0.95, "empirical")
 T51_ALPHAS = (1e-3, 1e-4, 1e-5, 1e-6)
 T51_NS = (10_000, 1_000, 100)
 #: Table 5.1 as printed: improvement ratio (%) by sigma, N, alpha.
-T51_PRINTED = {
+T51_PRINTED: dict[float, dict[int, tuple[float, ...]]] = {
     0.5: {10_000: (95.96, 100, 98.99, 100), 1_000: (52.85, 73.27, 81.88, 83.88), 100: (49.79, 51.41, 55.69, 58.44)},
     1.0: {10_000: (24.24, 100, 100, 100), 1_000: (37.4, 27.03, 99.9, 100), 100: (50.4, 46.08, 39.04, 86.04)},
 }
@@ -137,7 +163,7 @@ def _table_5_1_printed_theta0() -> Experiment:
 
 
 #: Table 5.2 as printed: (estimator, bound, empirical range, delta, Upsilon-bar, CI).
-_T52_PRINTED = [
+_T52_PRINTED: list[tuple[Estimator, Bound, bool, float, float, tuple[float, float]]] = [
     ("reinforce", "chebyshev", False, 0.95, -11.3266, (-11.3277, -11.3256)),
     ("reinforce", "chebyshev", False, 0.75, -11.4303, (-11.4308, -11.4297)),
     ("reinforce", "chebyshev", False, 0.5, -11.5947, (-11.5958, -11.5937)),
@@ -190,7 +216,7 @@ def _table_5_2_lemma_range() -> Experiment:
     configs, thesis = [], {}
     for c in _theoretical_range_rows(t52):
         name = f"{c.name}-lemma-range"
-        configs.append(replace(c, name=name, method=_with_error(c.method, range="lemma")))
+        configs.append(replace(c, name=name, method=_with_error(method_of(c, Adaptive), range="lemma")))
         thesis[name] = t52.thesis[c.name]
     return Experiment("table-5.2-lemma-range", "The two theoretical-range rows of Table 5.2 with Lemma "
                       "4.3.3's range 6400 instead of the reconstructed 1280 (the printed lemma, which "
@@ -223,7 +249,7 @@ _PRINTED_THETA_COORDINATE = [[-0.0275, 0.0], [0.0, -0.0274]]
 
 def _figures_5_5_5_6() -> Experiment:
     error = ErrorModel("chebyshev", 0.95)
-    configs = tuple(RunConfig(kind, method=Vanilla(2000, SafeStep(kind, error)), env="lqg2d-gamma0.9",
+    configs = tuple(RunConfig(kind, method=Vanilla(2000, SafeStep(kind, error)), task=LQG2D_TASK,
                               theta0=(0.0,) * 4) for kind in ("scalar", "coordinate"))
     thesis = {"scalar": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_SCALAR},
               "coordinate": {"improvement_ratio": 1.0, "theta_final": _PRINTED_THETA_COORDINATE}}
@@ -233,7 +259,7 @@ def _figures_5_5_5_6() -> Experiment:
 
 
 def _table_5_3() -> Experiment:
-    task = partial(RunConfig, env="lqg2d-gamma0.9", theta0=(0.0,) * 4)
+    task = partial(RunConfig, task=LQG2D_TASK, theta0=(0.0,) * 4)
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
                task("N=1000", method=Vanilla(1000, FixedStep(1e-6))),
                task("N=100", method=Vanilla(100, FixedStep(1e-6))))
@@ -254,7 +280,7 @@ _BASELINE_CAP = 4000 * 400
 
 
 def _cartpole_baseline() -> Experiment:
-    cfg = RunConfig("baseline", method=Vanilla(4000, FixedStep(0.01), target=Target(195.0)), env="cartpole",
+    cfg = RunConfig("baseline", method=Vanilla(4000, FixedStep(0.01), target=Target(195.0)), task="cartpole",
                     theta0=(0.0,) * 4, budget=_BASELINE_CAP)
     return Experiment("cartpole-baseline", "Cart-pole, 1 m pole: vanilla G(PO)MDP with alpha = 0.01 and "
                       "N = 4000 from theta = 0 until a batch's average return reaches 195 (Section 5.3).",
@@ -262,7 +288,7 @@ def _cartpole_baseline() -> Experiment:
 
 
 def _table_5_4() -> Experiment:
-    task = partial(RunConfig, env="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
+    task = partial(RunConfig, task="cartpole-doubled", warm_start="cartpole-baseline", budget=CARTPOLE_BUDGET)
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER)),
                task("N=4000", method=Vanilla(4000, FixedStep(0.01))))
     thesis = {"adaptive": {"upsilon_bar": 193.12, "improvement_ratio": 0.5301},
@@ -280,7 +306,7 @@ def _sweep_baselines() -> list[Experiment]:
     out = []
     for st in CARTPOLE_SWEEP.values():
         if st.task and st.warm_start is None:
-            cfg = replace(base.configs[0], env=st.env(doubled=False, constants=False), budget=SWEEP_BASELINE_CAP)
+            cfg = replace(base.configs[0], task=st.env(doubled=False, constants=False), budget=SWEEP_BASELINE_CAP)
             out.append(replace(base, name=st.baseline_experiment, configs=(cfg,), seeds=SWEEP_SEEDS,
                                description=f"Cart-pole sweep: the baseline search with {st.label} "
                                            f"(capped at {SWEEP_BASELINE_CAP // 4000} iterations)."))
@@ -294,11 +320,11 @@ def _cartpole_sweep() -> Experiment:
     for st in CARTPOLE_SWEEP.values():
         if not st.doubled:
             continue
-        common = dict(warm_start=st.baseline_experiment, budget=SWEEP_BUDGET)
-        configs.append(replace(adaptive, name=f"{st.key}:adaptive", env=st.env(doubled=True), **common))
+        configs.append(replace(adaptive, name=f"{st.key}:adaptive", task=st.env(doubled=True),
+                               warm_start=st.baseline_experiment, budget=SWEEP_BUDGET))
         if not st.constants or st.task:  # a constants-only setting shares the default's vanilla run
-            configs.append(replace(vanilla, name=f"{st.key}:N=4000", env=st.env(doubled=True, constants=False),
-                                   **common))
+            configs.append(replace(vanilla, name=f"{st.key}:N=4000", task=st.env(doubled=True, constants=False),
+                                   warm_start=st.baseline_experiment, budget=SWEEP_BUDGET))
     # Every setting is held against Table 5.4 as printed (report --json shows them side by side).
     thesis = {c.name: t54.thesis["adaptive" if c.algorithm == "adaptive" else "N=4000"] for c in configs}
     return Experiment("cartpole-sweep", "Cart-pole sweep over the settings the thesis leaves unstated: adaptive "
@@ -357,7 +383,7 @@ def _table_5_1_authors_tail() -> Experiment:
 
 def _table_5_3_authors() -> Experiment:
     adaptive = _table_5_3().config("adaptive")
-    cfg = replace(adaptive, method=replace(adaptive.method, batches=Batches(n_max=100_000),
+    cfg = replace(adaptive, method=replace(method_of(adaptive, Adaptive), batches=Batches(n_max=100_000),
                                            departures=AUTHORS_DEPARTURES))
     return Experiment("table-5.3-authors", "Table 5.3's adaptive run as the authors' script ran it: N_max = 100000, "
                       "Bernstein on the largest variance and range over the components, the step taken even when "
@@ -367,7 +393,7 @@ def _table_5_3_authors() -> Experiment:
 
 def _table_5_2_authors() -> Experiment:
     t52 = _table_5_2()
-    configs = tuple(replace(c, method=replace(c.method, departures=Departures(unguarded_step=True)))
+    configs = tuple(replace(c, method=replace(method_of(c, Adaptive), departures=Departures(unguarded_step=True)))
                     for c in _theoretical_range_rows(t52))
     return Experiment("table-5.2-authors", "Table 5.2's two theoretical-range rows as the authors' script ran them: "
                       "the range 1280, the step taken even when eps >= |g| (with this range, on the first batch).",
@@ -382,9 +408,10 @@ def _figures_5_1_5_2_authors() -> Experiment:
     for c in t52.configs:
         if c.name in theoretical:  # table-5.2-authors runs them under the authors' settings already
             continue
-        error = c.method.error
-        limits = settings[(c.method.gradient.estimator, error.bound, error.empirical_range, error.delta)]
-        configs.append(replace(c, method=replace(c.method, batches=Batches(limits["n_min"], limits["n_max"]),
+        method = method_of(c, Adaptive)
+        error = method.error
+        limits = settings[(method.gradient.estimator, error.bound, error.empirical_range, error.delta)]
+        configs.append(replace(c, method=replace(method, batches=Batches(limits["n_min"], limits["n_max"]),
                                                  departures=Departures(unguarded_step=True))))
     return Experiment("figures-5.1-5.2-authors", "The curves of Figures 5.1-5.2 (Table 5.2's rows but the two "
                       "theoretical-range ones, which table-5.2-authors runs) as the authors' script ran them: "
@@ -396,8 +423,8 @@ def _figures_5_1_5_2_authors() -> Experiment:
 def _cartpole_baseline_authors() -> Experiment:
     base = _cartpole_baseline()
     search = base.configs[0]
-    cfg = replace(search, env=_authors_cartpole(doubled=False),
-                  method=replace(search.method, target=Target(195.0, update=True)))
+    cfg = replace(search, task=_authors_cartpole(doubled=False),
+                  method=replace(method_of(search, Vanilla), target=Target(195.0, update=True)))
     return replace(base, name="cartpole-baseline-authors", configs=(cfg,), rules="authors",
                    description="The cart-pole baseline search on the authors' task (12 deg, undiscounted return): "
                                "vanilla G(PO)MDP, alpha = 0.01, N = 4000 from theta = 0 until a batch averages 195, "
@@ -406,15 +433,17 @@ def _cartpole_baseline_authors() -> Experiment:
 
 def _table_5_4_authors(theta_star: bool = False) -> Experiment:
     # Both runs as long as the authors' adaptive run, the window their table averages over.
-    start = (dict(theta0=tuple(float(v) for v in cartpole_theta_star())) if theta_star
-             else dict(warm_start="cartpole-baseline-authors"))
-    task = partial(RunConfig, env=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET, **start)
+    task = partial(RunConfig, task=_authors_cartpole(doubled=True), budget=TABLE_5_4_BUDGET)
+    if theta_star:
+        task = partial(task, theta0=tuple(float(v) for v in cartpole_theta_star()))
+    else:
+        task = partial(task, warm_start="cartpole-baseline-authors")
     configs = (task("adaptive", method=Adaptive(error=BERNSTEIN_ER, batches=Batches(n_min=10, first=1000),
                                                 departures=replace(AUTHORS_DEPARTURES, batch_constants=True))),
                task("N=4000", method=Vanilla(4000, FixedStep(0.01, "coordinate"))))
-    start = "their own baseline policy (theta_star.npy)" if theta_star else "each seed's cartpole-baseline-authors"
+    origin = "their own baseline policy (theta_star.npy)" if theta_star else "each seed's cartpole-baseline-authors"
     return Experiment(f"table-5.4-authors{'-theta-star' if theta_star else ''}",
-                      f"Table 5.4 as the authors ran it, from {start}: their doubled pole (m l kept at 0.05), 12 deg, "
+                      f"Table 5.4 as the authors ran it, from {origin}: their doubled pole (m l kept at 0.05), 12 deg, "
                       "undiscounted return; adaptive with gamma = 0.9 and R, M_phi measured per batch in c, first N = "
                       "1000, N_min = 10, the maxima over components, unguarded steps; 'vanilla' moving only the "
                       f"largest component by 0.01 g_k; {TABLE_5_4_BUDGET} trajectories each, counted as "
@@ -422,11 +451,9 @@ def _table_5_4_authors(theta_star: bool = False) -> Experiment:
 
 
 def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
-    """``exp`` with each config's task factory and the key of the run it warm-starts from."""
+    """``exp`` with the key of the run each config warm-starts from."""
     configs = []
     for c in exp.configs:
-        if c.env in THESIS_ENVS:
-            c = replace(c, env_factory=THESIS_ENVS[c.env])
         if c.warm_start is not None:
             c = replace(c, warm_start_key=registry[c.warm_start].single_config().key())
         configs.append(c)

@@ -7,17 +7,20 @@ Figure; the numbers behind every curve come from :mod:`safepg.thesis.analysis`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Literal
 
 import matplotlib as mpl
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from safepg.bounds import ErrorBound
 from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
+from safepg.record import on_trajectories
 from safepg.thesis import plotting
-from safepg.thesis.analysis import by_iteration, mean_band, measured_on_grid, performance_on_grid
+from safepg.thesis.analysis import by_iteration, mean_band
 
 Records = Mapping[str, Sequence[LearningRecord]]
 
@@ -27,12 +30,12 @@ def _grid(records: Records, points: int = 600) -> np.ndarray:
     return np.unique(np.linspace(1, total, points).astype(np.int64))
 
 
-def _performance_panel(ax: plt.Axes, records: Records, labels: Mapping[str, str],
+def _performance_panel(ax: Axes, records: Records, labels: Mapping[str, str],
                        styles: Mapping[str, dict], measured: bool = False) -> None:
     grid = _grid({k: records[k] for k in labels})
-    curve = measured_on_grid if measured else performance_on_grid
+    field: Literal["J", "J_hat"] = "J_hat" if measured else "J"
     for name, label in labels.items():
-        mean, lo, hi = mean_band(curve(records[name], grid))
+        mean, lo, hi = mean_band(on_trajectories(records[name], grid, field))
         st = styles[name]
         ax.plot(grid, mean, label=label, **st)
         ax.fill_between(grid, lo, hi, color=st.get("color"), alpha=0.2, linewidth=0)
@@ -55,12 +58,12 @@ def figure_4_1(g: float, bound: ErrorBound, c: float, n_max: float | None = None
     ax.plot(ns, upsilon(ns, g, bound, c, saturate=False), color=plotting.ACCENT)
     ax.axvspan(ns[0], n0, color="grey", alpha=0.15, label=r"$N < N_0$: no guarantee")
     ax.plot([n0], [0], "o", color="grey", label=f"$N_0$ = {n0:.0f}")
-    ax.plot([n_star], [upsilon(n_star, g, bound, c)], "D", color=plotting.ACCENT, label=f"$N^*$ = {n_star}")
+    ax.plot([n_star], [float(upsilon(n_star, g, bound, c))], "D", color=plotting.ACCENT, label=f"$N^*$ = {n_star}")
     ax.set_xscale("log")
     # Upsilon >= 0 and vanishes at N_0: a symmetric-log axis shows the zero and the decades
     # above it. Only the non-negative half is drawn and only decades are labelled, so no two
     # tick labels crowd around 0.
-    linthresh = upsilon(n_star, g, bound, c) / 10
+    linthresh = float(upsilon(n_star, g, bound, c)) / 10
     ax.set_yscale("symlog", linthresh=linthresh)
     top = float(np.nanmax(upsilon(ns, g, bound, c, saturate=False)))
     ax.set_ylim(0, top * 3)

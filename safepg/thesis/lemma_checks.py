@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from scipy import integrate
@@ -68,8 +68,16 @@ class CheckResult:
 
 
 # --------------------------------------------------------------------------- Gaussian policy
-def gaussian_pdf(a: np.ndarray, mean: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    r""":math:`\mathcal N(a; \mu, \sigma^2)`, elementwise."""
+@overload
+def gaussian_pdf(a: float, mean: float, sigma: float) -> float: ...
+
+
+@overload
+def gaussian_pdf(a: np.ndarray | float, mean: np.ndarray | float, sigma: np.ndarray | float) -> np.ndarray | float: ...
+
+
+def gaussian_pdf(a: np.ndarray | float, mean: np.ndarray | float, sigma: np.ndarray | float) -> np.ndarray | float:
+    r""":math:`\mathcal N(a; \mu, \sigma^2)`, elementwise (a float for floats)."""
     z = (a - mean) / sigma
     return np.exp(-0.5 * z**2) / (SQRT_2PI * sigma)
 

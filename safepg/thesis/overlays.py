@@ -10,18 +10,19 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, TypedDict
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
+from safepg.record import on_trajectories
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, plotting
-from safepg.thesis.analysis import measured_on_grid, performance_on_grid
 from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, cartpole_runs, lqg2d_runs
 
 # ---------------------------------------------------------------- Section 5.1: 1-D fixed-step runs
@@ -150,13 +151,25 @@ def figure_table51_overlay(records: Mapping[str, Sequence[LearningRecord]],
     return fig
 
 
+class OverlaySeries(TypedDict):
+    """One curve of Figures 5.1-5.2 on the authors' grid (:func:`figure51_52_overlay_series`)."""
+
+    x: np.ndarray
+    ours_mean: np.ndarray
+    ours_lo: np.ndarray
+    ours_hi: np.ndarray
+    authors: np.ndarray
+    values: np.ndarray
+    runs: int
+
+
 def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], config,
-                               processing: Processing = "text", runs: int | None = None) -> dict[str, np.ndarray]:
+                               processing: Processing = "text", runs: int | None = None) -> OverlaySeries:
     """One curve of Figures 5.1-5.2 on the authors' grid of T: ours (``values``, each seed's curve; their
     mean and 95% prediction band) and the authors' plotted curve.
 
     ``processing="text"``: each seed's closed-form J of the policy that generated trajectory T
-    (:func:`~safepg.thesis.analysis.performance_on_grid`), the band for a five-run mean (the caption).
+    (:func:`~safepg.record.on_trajectories`), the band for a five-run mean (the caption).
     ``processing="authors"``: each seed through the authors' :func:`~safepg.thesis.authors.grid_curve`
     (their ``scaleData.m``), the band for one run, as their curve is. ``runs`` sets the band's number
     of runs otherwise (to test one choice at a time).
@@ -168,7 +181,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
                                           error.delta)]
     grid = curve["trajectories"].astype(np.int64)
     if processing == "text":
-        values, n = performance_on_grid(records[config.name], grid), FIGURES_51_52_RUNS
+        values, n = on_trajectories(records[config.name], grid), FIGURES_51_52_RUNS
     else:
         mapped = [authors.grid_curve(r.batch_size, r.J[:-1]) for r in records[config.name]]
         if any(not np.array_equal(x, grid) for x, _ in mapped):
@@ -180,7 +193,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
             "runs": runs}
 
 
-def _figure51_52_panel(ax: plt.Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
+def _figure51_52_panel(ax: Axes, records: Mapping[str, Sequence[LearningRecord]], configs: Sequence,
                        colors: Mapping[str, str], labels: Mapping[str, str], processing: Processing) -> None:
     for c in configs:
         s = figure51_52_overlay_series(records, c, processing)
@@ -243,12 +256,13 @@ _LQG2D_COLORS = {"adaptive": "#7d4fb0", "adaptive-authors": "#c0392b", "N=1000":
 
 #: Our mean is drawn broad and light, their run dashed and dark on top of it, so both stay visible
 #: where they coincide.
-_LQG2D_OURS = {"linewidth": 2.6, "alpha": 0.6}
-_LQG2D_THEIRS = {"linestyle": (0, (4, 3)), "linewidth": 1.3, "zorder": 3}
+_LQG2D_OURS: dict[str, Any] = {"linewidth": 2.6, "alpha": 0.6}
+_LQG2D_THEIRS: dict[str, Any] = {"linestyle": (0, (4, 3)), "linewidth": 1.3, "zorder": 3}
 
 
 def _lqg2d_dark(key: str) -> tuple[float, float, float]:
-    return tuple(0.55 * c for c in to_rgb(_LQG2D_COLORS.get(key, "#444444")))
+    red, green, blue = to_rgb(_LQG2D_COLORS.get(key, "#444444"))
+    return 0.55 * red, 0.55 * green, 0.55 * blue
 
 
 def lqg2d_held(batch_size: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -271,10 +285,10 @@ def _lqg2d_grid(records: Mapping[str, Sequence[LearningRecord]], runs: Mapping[s
     return np.unique(np.linspace(1, total, points).astype(np.int64))
 
 
-def _lqg2d_authors_axis(ax: plt.Axes) -> None:
+def _lqg2d_authors_axis(ax: Axes) -> None:
     """A right-hand axis in the authors' units (16 times ours), for reading the printed figures."""
-    sec = ax.secondary_yaxis("right", functions=(lambda y: y * LQG2D_AUTHORS_SCALE,
-                                                 lambda y: y / LQG2D_AUTHORS_SCALE))
+    sec = ax.secondary_yaxis("right", functions=(lambda y: np.multiply(y, LQG2D_AUTHORS_SCALE),
+                                                 lambda y: np.divide(y, LQG2D_AUTHORS_SCALE)))
     sec.set_ylabel(f"authors' units ({LQG2D_AUTHORS_SCALE:g}× J)")
 
 
@@ -457,7 +471,7 @@ def cartpole_overlay_curves(records: Mapping[str, Sequence[LearningRecord]], gri
     grid = np.asarray(grid)
     ours = {}
     for name, recs in records.items():
-        values = measured_on_grid(recs, grid)
+        values = on_trajectories(recs, grid, "J_hat")
         mean, lo, hi = seed_band95(values)
         one = np.sum(~np.isnan(values), axis=0) < 2  # no band drawn where fewer than two seeds remain
         lo[one] = hi[one] = np.nan

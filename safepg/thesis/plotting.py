@@ -53,7 +53,7 @@ def use_style() -> None:
         set_matplotlib_formats("retina")
 
 
-def estimator_style(estimator: str) -> dict[str, str]:
+def estimator_style(estimator: str) -> dict[str, Any]:
     """Line style of an estimator (thesis: G(PO)MDP solid, REINFORCE dashed)."""
     return {"linestyle": ESTIMATOR_DASH[estimator]}
 

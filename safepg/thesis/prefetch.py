@@ -41,6 +41,8 @@ import numpy as np
 from tqdm import tqdm
 
 from safepg import runner
+from safepg.learning import LearningRecord
+from safepg.runner import RunConfig
 from safepg.thesis.experiment_store import experiment_folder, run_experiment
 from safepg.thesis.experiments import EXPERIMENTS, get_experiment, scaled
 
@@ -180,7 +182,7 @@ def _duration(seconds: float | None) -> str:
     return f"{s // 3600}h{s % 3600 // 60:02d}m" if s >= 3600 else f"{s // 60}m{s % 60:02d}s" if s >= 60 else f"{s}s"
 
 
-class _Bar(tqdm):
+class _Bar(tqdm):  # type: ignore[misc]  # tqdm ships no types (an Any base to mypy), and subclassing is the API
     """A tqdm bar with one more field for its format, ``{status}``."""
 
     def __init__(self, *args: Any, status: str = "", **kwargs: Any) -> None:
@@ -308,8 +310,8 @@ def _reporting_stored_runs(progress: Progress) -> Iterator[None]:
     """Tell ``progress`` of every run the runner stores (``run_configs`` stores each as it arrives)."""
     store = runner.store_run
 
-    def store_and_report(rec: Any, folder: Path, cfg: Any, k: int) -> None:
-        store(rec, folder, cfg, k)
+    def store_and_report(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
+        store(rec, folder, cfg, seed)
         progress.advance(int(np.sum(rec.batch_size)), float(cfg.budget))
 
     runner.store_run = store_and_report

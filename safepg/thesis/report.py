@@ -11,7 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from safepg.definition import to_dict
 from safepg.learning import CHECKPOINTS, LearningRecord
+from safepg.options import FixedStep, Vanilla
 from safepg.runner import RunConfig
 from safepg.stats import seed_summary95
 from safepg.thesis import authors
@@ -32,14 +34,17 @@ def _summary(exp: Experiment, cfg: RunConfig, rec: LearningRecord) -> tuple[floa
 
 def _authors_output(exp: Experiment, cfg: RunConfig) -> dict[str, Any] | None:
     """The authors' own output for ``cfg`` of an authors-settings experiment (their files, recomputed)."""
-    base = authors.cartpole_runs()["baseline"] if exp.rules == "authors" else None
-    fields = cfg.fields()
-    cell = (cfg.sigma, fields.get("batch_size"), fields.get("alpha"))
-    out = {"table-5.1-authors": lambda: authors.table_5_1().get(cell),
+    if exp.rules != "authors":
+        return None
+    base = authors.cartpole_runs()["baseline"]
+    m = cfg.method
+    cell = ((cfg.sigma, m.batch_size, m.step.alpha) if isinstance(m, Vanilla) and isinstance(m.step, FixedStep)
+            else None)
+    out = {"table-5.1-authors": lambda: None if cell is None else authors.table_5_1().get(cell),
            "table-5.3-authors": lambda: authors.table_5_3().get(cfg.name),
            "cartpole-baseline-authors": lambda: {"iterations": base.iterations, "J_hat_final": base["J_hat"][-1]},
            "table-5.4-authors": lambda: authors.table_5_4()["adaptive" if cfg.algorithm == "adaptive" else "fixed"]}
-    got = out.get(exp.name.removesuffix("-theta-star"), lambda: None)() if base is not None else None
+    got = out.get(exp.name.removesuffix("-theta-star"), lambda: None)()
     return None if got is None else {k: np.asarray(v).tolist() for k, v in got.items()}
 
 
@@ -56,17 +61,14 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
         j_at: dict[str, float] = {}
         for T in CHECKPOINTS if closed_form else ():
             vals = [r.J_at((T,)).get(str(T)) for r in recs]
-            if vals and all(v is not None for v in vals):
-                j_at[str(T)] = float(np.mean(vals))
+            known = [v for v in vals if v is not None]
+            if vals and len(known) == len(vals):
+                j_at[str(T)] = float(np.mean(known))
         # Components of theta that any seed's run changed (the thesis's remarks on which
         # entries the coordinate step leaves alone).
         updated = sorted({int(i) for r in recs for i in np.flatnonzero(r.theta[-1] != r.theta[0])})
-        f = c.fields()
         rows.append({
-            "name": c.name, "estimator": f["estimator"], "bound": f["bound"],
-            "empirical_range": f["empirical_range"], "delta": f["delta"], "sigma": c.sigma,
-            "algorithm": c.algorithm, "budget": c.budget, "batch_size": f.get("batch_size"), "alpha": f.get("alpha"),
-            "seeds": len(recs),
+            "name": c.name, "method": to_dict(c.method), "sigma": c.sigma, "budget": c.budget, "seeds": len(recs),
             "upsilon_bar": seed_summary95(_summary(exp, c, r)[0] for r in recs),
             "improvement_ratio": seed_summary95(_summary(exp, c, r)[1] for r in recs),
             "theta_moved": max((float(np.max(np.abs(r.theta_final - r.theta[0]))) for r in recs), default=None),

@@ -49,7 +49,7 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
     method = cfg.method
     if not isinstance(method, Adaptive):
         raise ValueError(f"cfg must be an adaptive run, got algorithm={cfg.algorithm!r}")
-    task = cfg.make_env()
+    task = cfg.make_task()
     simulated, written = task.gamma, getattr(task, "constants_gamma", None)
     one_discount = written is None or written == simulated
     from_bounds, guarded, per_component = method.departures.assumptions()
@@ -340,9 +340,12 @@ class MonteCarloOutcomes:
             raise ValueError("parts must hold at least one measurement")
         if any((p.looks, p.alpha) != (parts[0].looks, parts[0].alpha) for p in parts):
             raise ValueError("parts must share their looks and alpha")
-        return cls(*(np.concatenate([getattr(p, f) for p in parts])
-                     for f in ("updates", "change", "lower", "upper", "rollouts", "outcome")),
-                   looks=parts[0].looks, alpha=parts[0].alpha, steps=sum(p.steps for p in parts))
+
+        def joined(name: str) -> np.ndarray:
+            return np.concatenate([getattr(p, name) for p in parts])
+
+        return cls(joined("updates"), joined("change"), joined("lower"), joined("upper"), joined("rollouts"),
+                   joined("outcome"), looks=parts[0].looks, alpha=parts[0].alpha, steps=sum(p.steps for p in parts))
 
     def to_json(self) -> dict[str, Any]:
         """JSON-ready form (:meth:`from_json` reads it back)."""

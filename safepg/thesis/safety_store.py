@@ -15,6 +15,7 @@ import os
 import tempfile
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -55,8 +56,10 @@ def is_measured(folder: Path, env: Any, thetas: np.ndarray, sigma: float, looks:
     never moved theta needs none)."""
     T = np.ascontiguousarray(np.asarray(thetas, dtype=float))
     ks = moved_updates(T)
-    return ks.size == 0 or stored_measurement(*reversed(measurement_file(folder, env, T, sigma, ks, looks, alpha,
-                                                                          seed))) is not None
+    if ks.size == 0:
+        return True
+    blob, path = measurement_file(folder, env, T, sigma, ks, looks, alpha, seed)
+    return stored_measurement(path, blob) is not None
 
 
 def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma: float,
@@ -94,9 +97,8 @@ def cached_monte_carlo_changes(folder: Path, env: Any, thetas: np.ndarray, sigma
                                       for j in range(jobs))
         joined = MonteCarloOutcomes.join(parts)
         order = np.argsort(np.concatenate([np.arange(ks.size)[j::jobs] for j in range(jobs)]), kind="stable")
-        out = MonteCarloOutcomes(*(getattr(joined, f)[order] for f in ("updates", "change", "lower", "upper",
-                                                                        "rollouts", "outcome")),
-                                 looks=joined.looks, alpha=joined.alpha, steps=joined.steps)
+        out = replace(joined, updates=joined.updates[order], change=joined.change[order], lower=joined.lower[order],
+                      upper=joined.upper[order], rollouts=joined.rollouts[order], outcome=joined.outcome[order])
     seconds = time.perf_counter() - started  # benchmarks/bench_book.py and safepg.thesis.budget read it
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f"{path.stem}~", suffix=".tmp")
@@ -163,10 +165,11 @@ def table_5_4_runs(records: Any, their_runs: Any, window: int) -> dict[str, Meas
     """
     from safepg.thesis.experiments import get_experiment
 
-    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_env()
-    text_task = get_experiment("table-5.4").config("adaptive").make_env()  # gamma = 0.99, 41.8 degrees
-    runs = {"authors' adaptive run": (task, [their_runs["adaptive"]["theta"]], MC_LOOKS),
-            "authors' fixed-step run": (task, [their_runs["fixed"]["theta"][:window]], MC_LOOKS)}
+    task = get_experiment("table-5.4-authors-theta-star").config("adaptive").make_task()
+    text_task = get_experiment("table-5.4").config("adaptive").make_task()  # gamma = 0.99, 41.8 degrees
+    runs: dict[str, MeasuredRuns] = {
+        "authors' adaptive run": (task, [their_runs["adaptive"]["theta"]], MC_LOOKS),
+        "authors' fixed-step run": (task, [their_runs["fixed"]["theta"][:window]], MC_LOOKS)}
     for name, setting, t in (("table-5.4-authors", "ours, their settings", task),
                              ("table-5.4-authors-theta-star", "ours, their settings, their θ*", task),
                              ("table-5.4", "ours, thesis's text", text_task)):

@@ -100,8 +100,8 @@ class Variant:
 
 #: Every combination the sweep runs (3 baselines x 2 scores x 2 sigma readings).
 VARIANTS: tuple[Variant, ...] = tuple(
-    Variant(b, s, r) for b in ("none", "optimal", "average") for s in ("clipped", "raw")  # type: ignore[arg-type]
-    for r in ("std", "variance")  # type: ignore[arg-type]
+    Variant(b, s, r) for b in ("none", "optimal", "average") for s in ("clipped", "raw")
+    for r in ("std", "variance")
 )
 
 

@@ -25,11 +25,12 @@ from safepg.envs.cartpole import CartPole
 from safepg.learning import learn
 from safepg.options import Adaptive, ErrorModel, Vanilla
 from safepg.thesis.authors import cartpole_theta_star
-from safepg.thesis.experiments import AUTHORS_DOUBLED, get_experiment
+from safepg.thesis.experiments import AUTHORS_DOUBLED, get_experiment, method_of
 from safepg.thesis.explorers.ch5_live import (
     CURVE_POINTS,
     Ch5LiveExplorer,
     Reporter,
+    fixed,
     iteration_series,
     kernel_text,
     record_c,
@@ -38,7 +39,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
-from safepg.thesis.explorers.js_tasks import learner_options
+from safepg.thesis.explorers.option_names import learner_options
 
 #: Trajectories per run offered; small, so that a run takes seconds in a browser.
 BUDGETS = (10_000, 20_000, 50_000, 100_000, 200_000)
@@ -99,7 +100,7 @@ def cartpole_task(p: Mapping[str, Any]) -> CartPole:
 def adaptive_method(p: Mapping[str, Any]) -> Adaptive:
     """Algorithm 4.1 as the controls ``p`` set it: ``table-5.4``'s adaptive run (Bernstein with
     the empirical range) at the control's delta, with the ticked boxes' changes."""
-    method = replace(get_experiment("table-5.4").config("adaptive").method,
+    method = replace(method_of(get_experiment("table-5.4").config("adaptive"), Adaptive),
                      error=ErrorModel("bernstein", float(p["delta"]), "empirical"))
     for name, _, _, change in SETTINGS:
         if p[name]:
@@ -144,10 +145,6 @@ def _exp(v: float | None) -> str:
     return f"{mantissa}e{int(exponent):+d}"
 
 
-def _fixed(v: float | None, d: int) -> str:
-    return "-" if v is None else f"{v:.{d}f}"
-
-
 def settings_line(p: Mapping[str, Any]) -> str:
     """The settings a run used, in words (the page's ``safepgCartpoleSettings``)."""
     return ("Settings: " + ("gamma = 1 in the return, 0.9 in c" if p["gamma09"] else "gamma = 0.99")
@@ -187,7 +184,7 @@ def cartpole_result(p: Mapping[str, Any], traces: Mapping[str, Any], data: Mappi
         s["c_min"], s["c_max"] = (min(cs), max(cs)) if cs else (None, None)
         values[name] = s
         head = (f"{label}: {s['iterations']} iterations, {s['trajectories']} trajectories, mean batch return "
-                f"{_fixed(s['upsilon_bar'], 2)}")
+                f"{fixed(s['upsilon_bar'], 2)}")
         if name == "adaptive":
             theta0 = r["theta"][0]
             for j, nm in enumerate(data["theta_names"]):
@@ -247,13 +244,13 @@ def cartpole_explorer(baseline: Any = None) -> Ch5LiveExplorer:
         tasks[task_key(p)] = cartpole_task_data(cartpole_task(p))
     van = learner_options(vanilla_method())
     text = adaptive_method({"delta": 0.95, **{name: False for name, *_ in SETTINGS}})
-    base = learner_options(text)
+    text_options = learner_options(text)
     data = {"tasks": tasks, "starts": starts, "points": CURVE_POINTS, "frozen": FROZEN,
             "theta_names": list(THETA_NAMES), "theta_colors": list(THETA_COLORS), "task_boxes": list(TASK_BOXES),
             # Each box's options under the page learner's names, as far as they differ from the text's.
-            "settings": {name: {k: v for k, v in learner_options(change(text)).items() if base[k] != v}
+            "settings": {name: {k: v for k, v in learner_options(change(text)).items() if text_options[k] != v}
                          for name, _, _, change in SETTINGS},
-            "vanilla": {k: van[k] for k in ("batchSize", "alpha", "step")},
+            "adaptive": text_options, "vanilla": van,
             "vanilla_label": f"fixed step (N = {van['batchSize']}, alpha = {van['alpha']:g})"}
 
     def compute_py(p: Mapping[str, Any], progress: Reporter | None = None) -> dict[str, Any]:

@@ -27,7 +27,9 @@ from typing import Any
 
 import numpy as np
 
+from safepg.bounds import BOUNDS
 from safepg.learning import LearningRecord
+from safepg.options import ErrorModel
 from safepg.thesis.explorers.component import Explorer, static_text
 
 #: Points of each drawn curve: enough for a 640 px plot.
@@ -254,6 +256,15 @@ class Ch5LiveExplorer(Explorer):
         return f"{type(self).__name__}({self.title!r})"
 
 
-__all__ = ["BOUND_CHOICES", "CURVE_POINTS", "PAGE_ONLY", "Ch5LiveExplorer", "exp_text", "finite", "fixed",
-           "iteration_series", "kernel_text", "learner_source", "record_c", "record_trace", "thin", "trace_summary",
-           "trajectory_series"]
+
+def bound_control_error(control: str, delta: float) -> ErrorModel:
+    """The :class:`~safepg.options.ErrorModel` of a page's bound control: ``"bernstein-er"`` is
+    Bernstein's bound with the empirical range, ``"bernstein"`` with Lemma 4.3.3's."""
+    bound = control.removesuffix("-er")
+    if bound not in BOUNDS:  # as ErrorModel would say
+        raise ValueError(f"bound must be one of {', '.join(repr(c) for c in BOUNDS)}, got {bound!r}")
+    return ErrorModel(bound, delta, "empirical" if control.endswith("-er") else "lemma")
+
+__all__ = ["BOUND_CHOICES", "CURVE_POINTS", "PAGE_ONLY", "Ch5LiveExplorer", "bound_control_error", "exp_text", "finite",
+           "fixed", "iteration_series", "kernel_text", "learner_source", "record_c", "record_trace", "thin",
+           "trace_summary", "trajectory_series"]

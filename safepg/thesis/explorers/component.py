@@ -25,7 +25,7 @@ from __future__ import annotations
 import hashlib
 import html
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
@@ -105,8 +105,16 @@ class Plot:
     ymax: float | None = None
 
 
+class _SetAfterwards:
+    """What an explorer may be given after it is built, per class or per explorer: plain attributes,
+    not fields of the dataclass :class:`Explorer` (which takes every name annotated in its own body)."""
+
+    #: ``interactive()``: the heading, when the page's would be wrong in a kernel (None: ``title``).
+    kernel_title: str | None = None
+
+
 @dataclass
-class Explorer:
+class Explorer(_SetAfterwards):
     """An interactive figure that needs no kernel (see the module docstring).
 
     Parameters
@@ -120,7 +128,7 @@ class Explorer:
     """
 
     title: str
-    controls: list[Slider | Select | Checkbox]
+    controls: Sequence[Slider | Select | Checkbox]
     plots: list[Plot]
     compute_js: str
     compute_py: Callable[[dict[str, Any]], dict[str, Any]]
@@ -198,8 +206,6 @@ class Explorer:
     #: ``report(fraction, message)`` to call while it computes: the view shows how far it is,
     #: and ``report`` raises once the controls have moved on, which stops the computation.
     compute_reports_progress: ClassVar[bool] = False
-    #: ``interactive()``: the heading, when the page's would be wrong in a kernel (None: ``title``).
-    kernel_title: ClassVar[str | None] = None
 
     def interactive(self) -> Any:
         """ipywidgets version for a live kernel: the same controls, drawn with matplotlib

@@ -54,10 +54,10 @@ def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_v
     from safepg.thesis.analysis import sample_variance
 
     env = LQG.thesis_1d()
-    sigmas = np.round(np.linspace(0.2, 2.0, 19), 3) if sigmas is None else np.asarray(sigmas)
-    var = sample_variance(env, theta_var, sigmas, n, seed)
+    sigma_grid = np.round(np.linspace(0.2, 2.0, 19), 3) if sigmas is None else np.asarray(sigmas)
+    var = sample_variance(env, theta_var, sigma_grid, n, seed)
     data = {"theta_min": -1.2, "theta_max": 0.04, "points": 125, "gamma": env.gamma, "b": env.state_bound,
-            "theta_star": float(env.optimal_gain().item()), "sigmas": sigmas.tolist(), "theta_var": theta_var,
+            "theta_star": float(env.optimal_gain().item()), "sigmas": sigma_grid.tolist(), "theta_var": theta_var,
             "var_reinforce": var["reinforce"].tolist(), "var_gpomdp": var["gpomdp"].tolist(),
             "accent": plotting.ACCENT, "c_rf": plotting.MUTED, "c_gp": plotting.ACCENT}
 
@@ -65,12 +65,12 @@ def lqg_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, theta_v
         th = np.linspace(data["theta_min"], data["theta_max"], data["points"])
         J = [env.performance(t, p["sigma"]) for t in th]
         js = env.performance(data["theta_star"], p["sigma"])
-        vr = float(np.interp(p["sigma"], sigmas, data["var_reinforce"]))
-        vg = float(np.interp(p["sigma"], sigmas, data["var_gpomdp"]))
+        vr = float(np.interp(p["sigma"], sigma_grid, data["var_reinforce"]))
+        vg = float(np.interp(p["sigma"], sigma_grid, data["var_gpomdp"]))
         return {"plots": {"J": {"series": [{"x": th.tolist(), "y": J}],
                                 "markers": [{"x": data["theta_star"], "y": js}]},
-                          "var": {"series": [{"x": sigmas.tolist(), "y": data["var_reinforce"]},
-                                             {"x": sigmas.tolist(), "y": data["var_gpomdp"]}],
+                          "var": {"series": [{"x": sigma_grid.tolist(), "y": data["var_reinforce"]},
+                                             {"x": sigma_grid.tolist(), "y": data["var_gpomdp"]}],
                                   "markers": [{"x": p["sigma"], "y": vr}, {"x": p["sigma"], "y": vg}]}},
                 "values": {"J_star": js, "var_reinforce": vr, "var_gpomdp": vg}}
 
@@ -100,22 +100,22 @@ def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, the
     improvement. The empirical quantities (sample variance and range of the G(PO)MDP
     samples) come from real batches at ``theta`` on a sigma grid."""
     env = LQG.thesis_1d()
-    sigmas = np.round(np.linspace(0.5, 2.0, 16), 3) if sigmas is None else np.asarray(sigmas)
+    sigma_grid = np.round(np.linspace(0.5, 2.0, 16), 3) if sigmas is None else np.asarray(sigmas)
     from safepg.policies import LinearGaussianPolicy
 
     svar, srange = [], []
-    for s in sigmas:
-        x = env.gradient_batch(LinearGaussianPolicy([[theta]], s), n, np.random.default_rng(seed))[0][:, 0]
+    for s in sigma_grid:
+        x = env.gradient_batch(LinearGaussianPolicy(np.array([[theta]]), s), n, np.random.default_rng(seed))[0][:, 0]
         svar.append(float(np.var(x, ddof=1)))
         srange.append(float(np.ptp(x)))
     data = {"R": env.reward_bound, "M": env.feature_bound, "Avol": env.action_volume, "Abar": env.action_bound,
-            "gamma": env.gamma, "H": env.horizon, "sigmas": sigmas.tolist(), "sample_var": svar,
+            "gamma": env.gamma, "H": env.horizon, "sigmas": sigma_grid.tolist(), "sample_var": svar,
             "emp_range": srange, "points": 200, "accent": plotting.ACCENT, "muted": plotting.MUTED}
 
     def bound_for(p: dict[str, Any]) -> tuple[ErrorBound, float]:
         constants = TaskConstants.from_task(env, p["sigma"])
-        S = float(np.interp(p["sigma"], sigmas, svar))
-        er = float(np.interp(p["sigma"], sigmas, srange))
+        S = float(np.interp(p["sigma"], sigma_grid, svar))
+        er = float(np.interp(p["sigma"], sigma_grid, srange))
         b = p["bound"]
         bd = {"chebyshev-gpomdp": lambda: chebyshev(p["delta"], gpomdp_variance_factor(constants)),
               "chebyshev-reinforce": lambda: chebyshev(p["delta"], reinforce_variance_factor(constants)),
@@ -131,8 +131,9 @@ def upsilon_explorer(sigmas: Sequence[float] | None = None, n: int = 20_000, the
         n0 = n_zero(g, bd)
         ns = n_star_closed_form(g, bd) if bd.f == 0 else n_star_search(g, bd, c)
         N = np.geomspace(max(1.0, n0), 6 * ns, data["points"])
-        e = bd.eps(ns)
-        return {"plots": {"U": {"series": [{"x": N.tolist(), "y": upsilon(N, g, bd, c, saturate=False).tolist()}],
+        e = float(bd.eps(ns))
+        U = np.asarray(upsilon(N, g, bd, c, saturate=False))
+        return {"plots": {"U": {"series": [{"x": N.tolist(), "y": U.tolist()}],
                                 "markers": [{"x": n0, "y": 0.0}, {"x": ns, "y": upsilon(ns, g, bd, c)}]}},
                 "values": {"c": c, "d": bd.d, "f": bd.f, "N0": n0, "Nstar": ns,
                            "alpha": coordinate_step(g, e, c), "improvement": guaranteed_improvement(g, e, c)}}

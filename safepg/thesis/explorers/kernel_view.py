@@ -126,7 +126,7 @@ def figure_html(explorer: Any, png: bytes, width: int) -> str:
             f'style="width:{width}px;max-width:100%;height:auto">')
 
 
-class ExplorerView(w.VBox):
+class ExplorerView(w.VBox):  # type: ignore[misc]  # ipywidgets ships no types: its VBox is Any to mypy
     """An explorer's controls, status, progress bar and figure, computed in a worker thread.
 
     Parameters

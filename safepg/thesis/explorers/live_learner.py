@@ -41,11 +41,14 @@ from typing import Any
 import numpy as np
 
 from safepg import portable
+from safepg.definition import to_dict
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, learn
-from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, Vanilla
+from safepg.options import Adaptive, Batches, Departures, FixedStep, Gradient, Vanilla
+from safepg.record import on_trajectories
 from safepg.thesis import plotting
-from safepg.thesis.analysis import by_iteration, mean_band, performance_on_grid
+from safepg.thesis.analysis import by_iteration, mean_band
+from safepg.thesis.explorers.ch5_live import bound_control_error, fixed, thin
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider, static_text
 
 #: Budgets offered (trajectories); the stored runs are embedded up to the largest.
@@ -84,21 +87,13 @@ def _round(values: Any, digits: int = DIGITS) -> list[float | None]:
 
 
 def task_data(env: LQG | None = None) -> dict[str, Any]:
-    """The 1-D LQG settings and bound constants the JavaScript learner runs with."""
+    """The 1-D LQG the page's learner runs (:func:`~safepg.thesis.explorers.js_tasks.lqg_task_data`)."""
+    from safepg.thesis.explorers.js_tasks import lqg_task_data
+
     env = LQG.thesis_1d() if env is None else env
     if env.dim != 1:
         raise ValueError(f"env must be a one-dimensional LQG, got dim={env.dim}")
-    A, B, Q, R = (float(np.asarray(getattr(env, k), dtype=float).reshape(-1)[0]) for k in "ABQR")
-    return {"gamma": env.gamma, "H": env.horizon, "bs": env.state_bound, "ba": env.action_bound, "clip": env.clip,
-            "A": A, "B": B, "Q": Q, "Rc": R, "R": env.reward_bound, "M": env.feature_bound,
-            "Avol": env.action_volume, "Abar": env.action_bound}
-
-
-def _thin(n: int, points: int = CURVE_POINTS) -> np.ndarray:
-    """Indices of at most ``points`` evenly spread entries of a length-n curve (first and last kept)."""
-    if n <= points:
-        return np.arange(n)
-    return np.unique(np.floor(np.arange(points) * (n - 1) / (points - 1) + 0.5).astype(np.int64))
+    return lqg_task_data(env)
 
 
 def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> dict[str, Any]:
@@ -112,7 +107,7 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
     for i, (s, k) in enumerate(zip(starts, cut)):
         start[i, :k] = s[:k]
     start_mean = np.nanmean(start, axis=0)
-    keep = _thin(max(cut))
+    keep = np.asarray(thin(max(cut)))
     per_budget = {}
     for B in BUDGETS:
         ups, its = [], []
@@ -127,15 +122,15 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
             "delta": m.error.delta, "score": m.gradient.score_action, "seeds": len(recs), "name": cfg.name,
             "iteration": (keep + 1).tolist(), "start": _round(start_mean[keep]),
             "batch_size": _round(n[keep]), "alpha": _round(a[keep]),
-            "J": _round(mean_band(performance_on_grid(recs, grid))[0]), "budgets": per_budget}
+            "J": _round(mean_band(on_trajectories(recs, grid))[0]), "budgets": per_budget}
 
 
 def _matches_1d_table(cfg: Any) -> bool:
     """A stored configuration the live learner can rerun: Algorithm 4.1 on the 1-D LQG from
     theta_0 = 0, sigma = 1, with the default batch limits, range and a long enough budget."""
     m = cfg.method
-    return (isinstance(m, Adaptive) and cfg.env == "lqg1d" and tuple(cfg.theta0) == (0.0,)
-            and cfg.sigma == 1.0 and m.gradient.baseline and m.batches == Batches()
+    return (isinstance(m, Adaptive) and to_dict(cfg.make_task()) == to_dict(LQG.thesis_1d())
+            and tuple(cfg.theta0) == (0.0,) and cfg.sigma == 1.0 and m.gradient.baseline and m.batches == Batches()
             and m.departures == Departures() and m.error.theoretical_range is None and cfg.budget >= BUDGETS[-1]
             and cfg.warm_start is None)
 
@@ -266,11 +261,6 @@ def run_summary(rec: LearningRecord, tol: float) -> dict[str, Any]:
             "first_batches": rec.batch_size[:3].tolist(), "done": True, "diverged": rec.diverged}
 
 
-def _fixed(v: Any, digits: int) -> str:
-    """The page's number format: ``digits`` decimals, "-" for none."""
-    return "-" if v is None or not np.isfinite(v) else f"{v:.{digits}f}"
-
-
 def _moved_text(v: float) -> str:
     """A movement as the page writes it: 0, 7.0e-5 under 10^-3, else 4 decimals."""
     if not np.isfinite(v):
@@ -288,12 +278,12 @@ def run_line(name: str, v: Mapping[str, Any], data: Mapping[str, Any]) -> str:
     moved = _moved_text(v["theta_moved"])
     if v["ratio_vacuous"]:
         ratio = (f"theta moved by {moved}, less than {100 * data['still']:g}% of the way to theta* = "
-                 f"{_fixed(data['theta_star'], 2)}: the improvement ratio carries no information")
+                 f"{fixed(data['theta_star'], 2)}: the improvement ratio carries no information")
     else:
-        ratio = f"theta moved by {moved}, improvement ratio {_fixed(100 * v['improvement_ratio'], 2)}%"
+        ratio = f"theta moved by {moved}, improvement ratio {fixed(100 * v['improvement_ratio'], 2)}%"
     return (f"{name}: {v['iterations']} iterations, {v['trajectories']} trajectories, "
-            f"Upsilon-bar {_fixed(v['upsilon_bar'], 4)}, J {_fixed(v['J_final'], 3)} at theta "
-            f"{_fixed(v['theta_final'], 4)}{' (diverged)' if v['diverged'] else ''}; {ratio}.")
+            f"Upsilon-bar {fixed(v['upsilon_bar'], 4)}, J {fixed(v['J_final'], 3)} at theta "
+            f"{fixed(v['theta_final'], 4)}{' (diverged)' if v['diverged'] else ''}; {ratio}.")
 
 
 def objectives_line(data: Mapping[str, Any]) -> str:
@@ -314,7 +304,7 @@ def summary_text(values: Mapping[str, Any], data: Mapping[str, Any], budget: int
     th = values["thesis"]
     if th["found"]:  # toFixed(0) rounds halves up
         lines.append(f"stored safepg run {th['name']} (seed mean, first {budget} trajectories): "
-                     f"{math.floor(th['iterations'] + 0.5)} iterations, Upsilon-bar {_fixed(th['upsilon_bar'], 4)}.")
+                     f"{math.floor(th['iterations'] + 0.5)} iterations, Upsilon-bar {fixed(th['upsilon_bar'], 4)}.")
     else:
         lines.append("no stored run for these settings (Table 5.2 ran sigma = 1, baseline on, "
                      "delta in {0.05, 0.25, 0.5, 0.75, 0.95}).")
@@ -335,14 +325,14 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
     gradient = Gradient(p["estimator"], p["baseline"] == "on", p["score"])
     runs = 1 if p["vanilla_n"] == "off" else 2
 
-    def report(k: int, label: str) -> Callable[[int, int], None] | bool:
+    def report(k: int, label: str) -> Callable[[int, int], object] | bool:
         """safepg's per-batch report for run k, as a fraction of all runs (False: no report)."""
         if progress is None:
             return False
         return lambda used, total: progress((k * budget + used) / (runs * budget),
                                             f"{label}: {used:,} / {total:,} trajectories")
 
-    error = ErrorModel(bound.removesuffix("-er"), float(p["delta"]), "empirical" if bound.endswith("-er") else "lemma")
+    error = bound_control_error(bound, float(p["delta"]))
     recs = {"adaptive": learn(env, Adaptive(gradient, error), 0.0, float(p["sigma"]), budget=budget,
                               rng=np.random.default_rng(seed), progress=report(0, "Algorithm 4.1"))}
     if p["vanilla_n"] != "off":
@@ -357,16 +347,16 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         k = next((i for i, s in enumerate(run["start"]) if s is None or s >= budget), len(run["start"]))
         g = int(np.searchsorted(data["grid"], budget, side="right"))
         seeds = f"{run['seeds']} seed{'' if run['seeds'] == 1 else 's'}"
-        thin = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({seeds})"}
-        plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **thin})
-        plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **thin})
-        plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **thin})
+        muted = {"color": data["muted"], "dash": True, "label": f"stored safepg run ({seeds})"}
+        plots["N"]["series"].append({"x": run["iteration"][:k], "y": run["batch_size"][:k], **muted})
+        plots["J"]["series"].append({"x": data["grid"][:g], "y": run["J"][:g], **muted})
+        plots["alpha"]["series"].append({"x": run["iteration"][:k], "y": run["alpha"][:k], **muted})
         values["thesis"] = {"found": True, "key": key, "name": run["name"], **run["budgets"][str(budget)]}
     else:
         values["thesis"] = {"found": False, "key": key}
     values["vanilla"] = None
     for name, rec in recs.items():
-        keep = _thin(rec.iterations, data["points"])
+        keep = np.asarray(thin(rec.iterations, data["points"]))
         style = ({"color": data["colors"][bound], "dash": p["estimator"] == "reinforce"} if name == "adaptive"
                  else {"color": data["vanilla_color"], "dash": False})
         style["label"] = ("Algorithm 4.1 (safepg)" if name == "adaptive"
@@ -375,7 +365,7 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         plots["alpha"]["series"].append({"x": (keep + 1).tolist(), "y": rec.alpha[keep].tolist(), **style})
         T = np.unique(np.maximum(1, np.round(1 + np.arange(data["points"]) * (budget - 1) / (data["points"] - 1))))
         T = T[T <= rec.trajectories].astype(np.int64)
-        plots["J"]["series"].append({"x": T.tolist(), "y": performance_on_grid([rec], T)[0].tolist(), **style})
+        plots["J"]["series"].append({"x": T.tolist(), "y": on_trajectories([rec], T)[0].tolist(), **style})
         values[name] = run_summary(rec, still_tolerance(data, float(rec.theta[0, 0])))
     return {"plots": plots, "values": values, "text": summary_text(values, data, budget)}
 

@@ -32,6 +32,7 @@ from safepg.thesis.explorers.ch5_live import (
     CURVE_POINTS,
     Ch5LiveExplorer,
     Reporter,
+    bound_control_error,
     fixed,
     iteration_series,
     kernel_text,
@@ -41,7 +42,7 @@ from safepg.thesis.explorers.ch5_live import (
     trajectory_series,
 )
 from safepg.thesis.explorers.component import Checkbox, Plot, Select, Slider
-from safepg.thesis.explorers.js_tasks import learner_options
+from safepg.thesis.explorers.option_names import learner_options
 
 #: Budgets offered (trajectories per run); the experiments ran 3*10^7.
 BUDGETS = (30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
@@ -83,9 +84,8 @@ def _task_or_none(env: LQG) -> dict[str, Any] | None:
 
 
 def _error(p: Mapping[str, Any]) -> ErrorModel:
-    """The bound control (``"bernstein-er"``: with the empirical range) at the delta control."""
-    b = str(p["bound"])
-    return ErrorModel(b.removesuffix("-er"), float(p["delta"]), "empirical" if b.endswith("-er") else "lemma")
+    """The bound control at the delta control."""
+    return bound_control_error(str(p["bound"]), float(p["delta"]))
 
 
 def _seed(p: Mapping[str, Any]) -> int:
@@ -163,13 +163,14 @@ def lqg2d_steps_explorer() -> Ch5LiveExplorer:
 
     method = cfg.method
     assert isinstance(method, Vanilla) and isinstance(method.step, SafeStep)
-    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, method.step.error.delta),
-                Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
-                Select("bound", "bound", BOUND_CHOICES, method.step.error.bound),
-                Select("n", "N", tuple((str(n), f"{n:,}") for n in (100, 500, 1000, 2000, 5000, 10_000)),
-                       str(method.batch_size)),
-                Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
-                Slider("seed", "seed", 0, 99, 1, 0)]
+    controls: list[Slider | Select | Checkbox] = [
+        Slider("delta", "delta", 0.05, 0.95, 0.05, method.step.error.delta),
+        Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
+        Select("bound", "bound", BOUND_CHOICES, method.step.error.bound),
+        Select("n", "N", tuple((str(n), f"{n:,}") for n in (100, 500, 1000, 2000, 5000, 10_000)),
+               str(method.batch_size)),
+        Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
+        Slider("seed", "seed", 0, 99, 1, 0)]
     plots = [Plot("theta", "updates", "gain theta_11, theta_22"), Plot("J", "updates", "expected performance J")]
     ex = Ch5LiveExplorer("Figures 5.5-5.6 live: the scalar step against the coordinate step on the 2-D LQG, "
                          "computed in your browser", controls, plots, "", compute_py, data)
@@ -234,7 +235,7 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
     data = {"task": _task_or_none(env), "theta0": list(cfg.theta0), "points": CURVE_POINTS,
             "runs": [["adaptive", ADAPTIVE_COLOR], *[[n, c] for n, _, c in FIXED_RUNS]],
             "authors": {k: v for k, v in learner_options(authors_2d()).items()
-                        if k in ("statistics", "stepWhenUnsafe", "nFirst", "nMax")},
+                        if k in ("maxima", "unguardedStep", "first")},
             "printed": (f"Table 5.3 prints after 3*10^7 trajectories: Upsilon-bar {t['adaptive']['upsilon_bar']} "
                         f"(adaptive), {t['N=1000']['upsilon_bar']} (N = 1000), {t['N=100']['upsilon_bar']} "
                         "(N = 100).")}
@@ -251,15 +252,16 @@ def lqg2d_adaptive_explorer() -> Ch5LiveExplorer:
 
     method = cfg.method
     assert isinstance(method, Adaptive)
-    controls = [Slider("delta", "delta", 0.05, 0.95, 0.05, method.error.delta),
-                Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
-                Select("bound", "bound", BOUND_CHOICES, "bernstein-er"),
-                Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
-                Slider("seed", "seed", 0, 99, 1, 0),
-                Select("n_max", "N_max", tuple((str(n), f"{n:,}") for n in (10_000, 100_000, 500_000)),
-                       str(method.batches.n_max)),
-                Checkbox("authors", "the authors' adaptive settings (max statistics, unguarded step, "
-                                    "first N 100, N_max 100,000)", False)]
+    controls: list[Slider | Select | Checkbox] = [
+        Slider("delta", "delta", 0.05, 0.95, 0.05, method.error.delta),
+        Slider("sigma", "sigma", 0.25, 2.0, 0.05, cfg.sigma),
+        Select("bound", "bound", BOUND_CHOICES, "bernstein-er"),
+        Select("budget", "trajectories", tuple((str(b), f"{b:,}") for b in BUDGETS), "100000"),
+        Slider("seed", "seed", 0, 99, 1, 0),
+        Select("n_max", "N_max", tuple((str(n), f"{n:,}") for n in (10_000, 100_000, 500_000)),
+               str(method.batches.n_max)),
+        Checkbox("authors", "the authors' adaptive settings (max statistics, unguarded step, "
+                            "first N 100, N_max 100,000)", False)]
     plots = [Plot("J", "trajectories", "expected performance J"),
              Plot("N", "iteration", "batch size N", ylog=True)]
     ex = Ch5LiveExplorer("Figures 5.7-5.8 live: adaptive batch size against fixed N on the 2-D LQG, computed in "

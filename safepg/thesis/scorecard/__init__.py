@@ -3,7 +3,7 @@ r"""The reproduction scorecard: every quantitative result the thesis prints, our
 One :class:`Row` per printed result, built from the same sources the chapters use:
 
 * the stored runs of the Chapter 5 experiments, summarised by
-  :func:`safepg.thesis.experiments.report` (every cell of Tables 5.1-5.4, the improvement ratios,
+  :func:`safepg.thesis.report.report` (every cell of Tables 5.1-5.4, the improvement ratios,
   the final parameters of Section 5.2.1, the cart-pole baseline's iteration count), with
   the printed values taken from each :class:`~safepg.thesis.experiments.Experiment`'s ``thesis``;
 * the closed forms of :class:`safepg.envs.lqg.LQG` (:math:`\theta^*`, :math:`J(\theta^*)`)

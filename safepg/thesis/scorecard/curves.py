@@ -119,7 +119,10 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
     for (figure, curve), sides in grouped.items():
         group, page, heading = FIGURE_PLACES[figure]
         ours, theirs = (_column(sides[k]) if k in sides else None for k in ("ours", "authors"))
-        first = (ours or theirs)["worst"]  # type: ignore[index]
+        shown = ours or theirs
+        if shown is None:  # not reached: a curve is grouped under the side whose score it has
+            raise TypeError(f"figure {figure}, {curve}: no column to show")
+        first = shown["worst"]
         authors = AuthorsColumn() if theirs is None else AuthorsColumn(
             text=theirs["text"], value=theirs["share"], ok=theirs["holds"], seeds=theirs["seeds"],
             experiment=theirs["worst"].experiment, interval_text=theirs["band"], note=AUTHORS_NOTES.get(figure, ""))
@@ -136,7 +139,7 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
         # What their curve is: under their processing, one run whatever the caption says.
         kind = (f"{theirs['worst'].kind}, which the caption calls averaged over 5 runs"
-                if processed and figure in ("5.1", "5.2") else first.kind)
+                if theirs is not None and processed and figure in ("5.1", "5.2") else first.kind)
         b.add(RowSpec(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
               where=first.where, thesis=f"the authors' curve ({kind})",
               ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],

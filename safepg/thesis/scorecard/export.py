@@ -67,9 +67,13 @@ def headline_numbers(rows: Sequence[Row]) -> dict[str, float]:
     out["n_cartpole"] = len(cartpole)
     out["n_cartpole_authors_settings"] = sum(r.status == AUTHORS_STATUS for r in cartpole)
     j_star = next(r for r in rows if r.id == "section-5.2/J-star")
-    out["j_star_printed"] = j_star.thesis_value
-    out["j_star_expected"] = j_star.ours_value
-    out["j_star_ratio"] = j_star.authors_value / j_star.ours_value
+    printed, expected, theirs = j_star.thesis_value, j_star.ours_value, j_star.authors_value
+    if printed is None or expected is None or theirs is None:
+        raise TypeError(f"the row {j_star.id} must hold the printed, expected and authors' J(theta*), got "
+                        f"{printed!r}, {expected!r} and {theirs!r}")
+    out["j_star_printed"] = printed
+    out["j_star_expected"] = expected
+    out["j_star_ratio"] = theirs / expected
     return out
 
 
@@ -84,11 +88,19 @@ CSV_COLUMNS = ("id", "group", "quantity", "where", "kind", "thesis", "ours", "di
 TABLES = {"table-5.1": "table-5.1/", "table-5.2": "table-5.2/", "table-5.3": "table-5.3/", "table-5.4": "table-5.4/"}
 
 
+def _ends(interval: list[float] | None) -> tuple[float | None, float | None]:
+    """An interval's low and high ends as the CSV holds them (None and None for no interval)."""
+    if not interval:
+        return None, None
+    lo, hi = interval
+    return lo, hi
+
+
 def _flat(r: Row) -> dict[str, Any]:
     d = {k: getattr(r, k) for k in CSV_COLUMNS if hasattr(r, k)}
-    lo, hi = (r.ours_ci95 or [None, None])
-    a_lo, a_hi = (r.authors_ci95 or [None, None])
-    j_lo, j_hi = (r.judged_interval or [None, None])
+    lo, hi = _ends(r.ours_ci95)
+    a_lo, a_hi = _ends(r.authors_ci95)
+    j_lo, j_hi = _ends(r.judged_interval)
     d.update(ours_ci95_low=lo, ours_ci95_high=hi, authors_ci95_low=a_lo, authors_ci95_high=a_hi,
              judged_interval_low=j_lo, judged_interval_high=j_hi)
     return d

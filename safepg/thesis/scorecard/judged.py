@@ -11,11 +11,13 @@ import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
+from safepg.options import FixedStep, Vanilla
 from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis.analysis import one_cell_spread
-from safepg.thesis.experiments import Experiment
-from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction
+from safepg.thesis.experiments import Experiment, method_of
+from safepg.thesis.scorecard import outputs
+from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction, intervals_overlap, is_slip
 from safepg.thesis.scorecard.text import pct
 
 
@@ -82,6 +84,18 @@ def ratio_text(row: Mapping[str, Any] | None) -> str:
     return pi_text(interval, lambda x: f"{x:.1f}%", row["seeds"], widened)
 
 
+def overlaps_printed(printed: Sequence[float]) -> Callable[[float, list[float] | None], bool | None]:
+    """Rule ``"ci-overlap"`` as a column under the authors' settings applies it: ``check(mean, ci)``, our
+    interval ``ci`` against the ``printed`` one."""
+
+    def check(_: float, ci: list[float] | None) -> bool:
+        if ci is None:  # intervals_overlap cannot sort None either
+            raise TypeError("rule 'ci-overlap' needs our interval, got None")
+        return intervals_overlap(ci, printed)
+
+    return check
+
+
 def one_run_ratio(printed: float, row: Mapping[str, Any] | None) -> bool | None:
     """Rule ``"prediction"`` on an improvement ratio: the printed percentage in :func:`ratio_interval`."""
     return in_prediction(f"{100 * printed:.6g}", ratio_interval(row))
@@ -92,10 +106,15 @@ def tail_placement(tail: Experiment | None, recs: Mapping[str, Sequence[Learning
     """Where the printed cell of ``tail`` (one Table 5.1 cell, many seeds under the authors' settings)
     lies among our runs of it (``recs``: its runs by config): the note's values by cell (sigma, N,
     alpha); empty without two runs that differ."""
-    cfg = None if tail is None else tail.single_config()
-    if cfg is None or len(recs.get(cfg.name, ())) < 2:
+    if tail is None:
         return {}
-    cell = (cfg.sigma, cfg.method.batch_size, cfg.method.step.alpha)
+    cfg = tail.single_config()
+    if len(recs.get(cfg.name, ())) < 2:
+        return {}
+    method = method_of(cfg, Vanilla)
+    if not isinstance(method.step, FixedStep):
+        raise TypeError(f"the tail cell {cfg.name!r} must run a fixed step, got {method.step!r}")
+    cell = (cfg.sigma, method.batch_size, method.step.alpha)
     theta_star = float(LQG.thesis_1d().optimal_gain().ravel()[0])
     s = one_cell_spread(recs[cfg.name], tail.thesis[cfg.name]["improvement_ratio"],
                         authors.table51_runs()[cell]["theta"], theta_star)
@@ -107,3 +126,12 @@ def tail_placement(tail: Experiment | None, recs: Mapping[str, Sequence[Learning
                            at_least=s["at_least"], z=s["z"], theta_star=theta_star,
                            crossing_theirs=s["crossing_theirs"],
                            crossing_ours=f"{c.min()} to {c.max()} (mean {c.mean():.0f})")}
+
+
+def slip_sentence(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
+    """The sentence naming a slip between the authors' output and the print ("" when none).
+    ``printed`` as printed (a percentage for a ratio: ``scale`` 100 brings the output there)."""
+    if out.value is None or not out.complete or not is_slip(scale * out.value, printed):
+        return ""
+    return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
+            f"({out.source}), the thesis prints {show(float(printed))}.")

@@ -54,7 +54,7 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
         Results store (default ``$SAFEPG_RESULTS`` or ``results/``).
     run : bool
         Compute the missing runs of :data:`NEEDED` and :data:`RANGE_VARIANTS` first
-        (:func:`~safepg.thesis.experiments.run_experiment`); with ``False`` only stored runs are
+        (:func:`~safepg.thesis.experiment_store.run_experiment`); with ``False`` only stored runs are
         read, and rows without runs are ``"open"``. The authors' variants
         (:data:`AUTHORS_VARIANTS`) are always only read.
     experiments : mapping, optional

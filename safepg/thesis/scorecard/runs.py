@@ -1,5 +1,5 @@
 """Rows of the stored runs of Chapter 5: Tables 5.1-5.4, Figures 5.5-5.7, the step sizes and the
-cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.experiments.report`).
+cart-pole's baseline, from the experiments' reports (:func:`safepg.thesis.report.report`).
 
 Each row holds ours (the thesis's text), ours under the authors' settings where a variant runs
 them (the ``*-authors`` experiments; for Table 5.2's theoretical range, the authors' formula) and
@@ -17,17 +17,19 @@ from safepg.learning import LearningRecord
 from safepg.options import Adaptive, FixedStep, Vanilla
 from safepg.runner import RunConfig
 from safepg.stats import prediction_interval95
-from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment
+from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment, method_of
 from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.judged import (
     ci_judged,
     frozen,
     one_run_ratio,
+    overlaps_printed,
     pi_text,
     prediction,
     ratio_interval,
     ratio_text,
+    slip_sentence,
     tail_placement,
 )
 from safepg.thesis.scorecard.rules import (
@@ -45,7 +47,6 @@ from safepg.thesis.scorecard.rules import (
     half_unit,
     in_prediction,
     intervals_overlap,
-    is_slip,
     order_of_magnitude,
     within_points,
 )
@@ -67,9 +68,10 @@ def _row_key(c: RunConfig) -> tuple[str, str, bool, float]:
 
 
 def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
-    m, ci = d.get("mean"), d.get("ci95")
+    m = d.get("mean")
     if m is None:
         return None, None
+    ci = d["ci95"]  # a summary with a mean has its interval (safepg.stats.mean_ci95)
     return float(m), [float(ci[0]), float(ci[1])]
 
 
@@ -90,15 +92,6 @@ def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[fl
     return replace(column, ok=check(mean, ci), interval=interval, interval_text=interval_text, vacuous=vacuous)
 
 
-def _slip(out: outputs.Output, printed: str, show: Callable[[float], str], scale: float = 1.0) -> str:
-    """The sentence naming a slip between the authors' output and the print ("" when none).
-    ``printed`` as printed (a percentage for a ratio: ``scale`` 100 brings the output there)."""
-    if out.value is None or not out.complete or not is_slip(scale * out.value, printed):
-        return ""
-    return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
-            f"({out.source}), the thesis prints {show(float(printed))}.")
-
-
 def _said(column: AuthorsColumn) -> str:
     """Ours under the authors' settings as a note quotes it."""
     return "(not stored yet)" if not column.experiment or column.text == "-" else column.text
@@ -114,12 +107,15 @@ def _report_row(rep: Mapping[str, Any] | None, name: str) -> Mapping[str, Any] |
 def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed: Experiment,
                     printed_rep: Mapping[str, Any], authors: Experiment | None,
                     authors_rep: Mapping[str, Any] | None,
-                    tail: Mapping[tuple[float, int, float], TailRuns] | None = None) -> None:
+                    tail: Mapping[tuple[float, int, float], TailRuns] | None = None,
+                    tail_exp: Experiment | None = None, tail_rep: Mapping[str, Any] | None = None) -> None:
     """Table 5.1, cell by cell: ours from the printed theta_0 (``printed``), ours under the authors'
-    settings (their theta_0 and counting) and their output; ``exp`` (our reconstructed theta_0, found
-    before their outputs were read) is quoted in the explanation; ``tail`` places a print among ours."""
+    settings (their theta_0 and counting; a cell ``tail_exp`` ran again with more seeds, on those once
+    all are stored: five seeds' verdict there followed the seeds) and their output; ``exp`` (our
+    reconstructed theta_0) is quoted in the explanation; ``tail`` places a print among ours."""
     recon = {_cell(c): r for c, r in zip(exp.configs, rep["configs"])}
-    theirs = {_cell(c): r for c, r in zip(authors.configs if authors else (), (authors_rep or {}).get("configs", []))}
+    theirs = {_cell(c): (e, r) for e, er in ((authors, authors_rep), (tail_exp, tail_rep)) if e is not None
+              for c, r in zip(e.configs, (er or {}).get("configs", [])) if e is authors or r["seeds"] >= e.seeds}
     starts = Theta0s(printed_theta0=f"{T51_PRINTED_THETA0:g}", authors_theta0=f"{AUTHORS_T51_THETA0:g}")
     for c, r in zip(printed.configs, printed_rep["configs"]):
         thesis = (r["thesis"] or {}).get("improvement_ratio")
@@ -128,9 +124,9 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
         key = sigma, n, alpha = _cell(c)
         mean, ci = _mean_ci(r["improvement_ratio"])
         ok = None if mean is None else one_run_ratio(thesis, r)
-        ar = theirs.get(key)
+        a_exp, ar = theirs.get(key, (authors, None))
         a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
-        a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
+        a_col = _authors(a_exp, ar["seeds"] if ar else 0, a_mean, a_ci,
                          pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
                          lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
                          interval=ratio_interval(ar), interval_text=ratio_text(ar),
@@ -154,7 +150,7 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
                               f"our prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} "
                               "(where all 24 of their output files start), counted as they counted (strict increases "
                               "over 10^6/N - 1 updates), it is inside." + recon_text),
-              slip_note=_slip(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
+              slip_note=slip_sentence(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
               fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]}, output=out,
               note_id="table-5.1/tail" if key in (tail or {}) else None, note_values=(tail or {}).get(key, starts)))
 
@@ -171,7 +167,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
     fmt = lambda x: num(x, dec)  # noqa: E731
     lemma = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
-        if vc.method.error.theoretical_range is None:
+        if method_of(vc, Adaptive).error.theoretical_range is None:
             lemma[_row_key(vc)] = (vc, vr)
     ratios, still = [], []
     for c, r in zip(exp.configs, rep["configs"]):
@@ -194,20 +190,18 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             if authors is not None:
                 a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
                 a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}",
-                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar and ar["seeds"]))
+                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", overlaps_printed(th["ci95"]),
+                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar["seeds"] if ar else None))
             else:
                 a_col = _authors(exp, seeds, mean, ci, guarded,
-                                 lambda _, c95, t=th["ci95"]: intervals_overlap(c95, t),  # type: ignore[arg-type]
-                                 interval=ci, interval_text=ci_judged(ci, fmt, seeds))
+                                 overlaps_printed(th["ci95"]), interval=ci, interval_text=ci_judged(ci, fmt, seeds))
             mean, ci = _mean_ci(vr["upsilon_bar"])
             seeds = vr["seeds"]
             range_runs = RangeRuns(f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
                                    f"authors' settings {a_col.text or '-'} over "
                                    f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
-        ok = None if mean is None else intervals_overlap(ci, th["ci95"])
+        ok = None if mean is None or ci is None else intervals_overlap(ci, th["ci95"])
         er = " (e.r.)" if empirical_range else ""
         label = f"{estimator}-{bound}{'-er' if empirical_range else ''}-delta={delta:g}"
         b.add(RowSpec(id=f"table-5.2/{label}", group="Section 5.1",
@@ -224,9 +218,9 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   "(lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
                   f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
-              slip_note=_slip(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
-              fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range,
-                      "delta": delta, "theoretical_range": None if theoretical else c.method.error.theoretical_range,
+              slip_note=slip_sentence(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
+              fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range, "delta": delta,
+                      "theoretical_range": None if theoretical else method_of(c, Adaptive).error.theoretical_range,
                       "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
     complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
@@ -272,11 +266,11 @@ def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, r
     if authors is not None:
         a_names = [c.name for c in authors.configs]
         got = dict(authors_recs or {})
-        a_med = _median_steps(got, a_names, 1)
+        a_med = _median_steps(got, a_names, 1) or []  # no medians: None and [] alike
         n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
         a_col = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
                          f"median {np.median(a_med):.1e}" if a_med else "-",
-                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))  # type: ignore[union-attr]
+                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))
     b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{exponent}",
           ours=ours,
           difference=diff, ok=ok, rule="order", kind="read off a figure", page=page, heading=heading,
@@ -293,8 +287,8 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             mean, ci = _mean_ci(r["improvement_ratio"])
             out = outputs.lqg2d(c.name, "improvement_ratio")
             b.add(RowSpec(id=f"figures-5.5-5.6/{c.name}/improvement-ratio", group="Section 5.2", output=out,
-                  quantity=f"improvement ratio, {label}, N = {c.method.batch_size}", where="Section 5.2.1 (Figure 5.5)",
-                  thesis=pct(th["improvement_ratio"]),
+                  quantity=f"improvement ratio, {label}, N = {method_of(c, Vanilla).batch_size}",
+                  where="Section 5.2.1 (Figure 5.5)", thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
                   ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r),
@@ -316,7 +310,7 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                 # Without a seed the row is not judged, and its note, which quotes them, not filled.
                 final = FinalTheta(out.text, f"{seeds.min():.6g} to {seeds.max():.6g}") if seeds.size else None
                 b.add(RowSpec(id=rid, group="Section 5.2", quantity=f"final θ{i + 1}{j + 1}, {label}", output=out,
-                      slip_note=_slip(out, text, lambda v: f"{v:.6g}"),
+                      slip_note=slip_sentence(out, text, lambda v: f"{v:.6g}"),
                       where="Section 5.2.1 (after Figure 5.5)", thesis=text,
                       ours="-" if mean is None else
                       f"{mean:.6g} (seeds {seeds.min():.6g} to {seeds.max():.6g})",
@@ -353,7 +347,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
             a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
             a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
                              lambda *_, t=text, i=a_pi: in_prediction(t, i), interval=a_pi,
-                             interval_text=pi_text(a_pi, fmt, ar and ar["seeds"]))
+                             interval_text=pi_text(a_pi, fmt, ar["seeds"] if ar else None))
             out = output(c.name, "upsilon_bar") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(pi, fmt)}",
@@ -362,7 +356,8 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   page=page, heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
                   interval=pi, interval_text=pi_text(pi, fmt, r["seeds"]),
-                  authors=replace(a_col, note=authors_note), slip_note="" if out is None else _slip(out, text, fmt),
+                  authors=replace(a_col, note=authors_note),
+                  slip_note="" if out is None else slip_sentence(out, text, fmt),
                   remark=_missing(out) or _also(also, other, "upsilon_bar", fmt, text),
                   output=out, note_values=note_values))
         if "improvement_ratio" in th:
@@ -374,7 +369,7 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                                                    lambda x: pct(x, 1)),
                              lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
                              interval=ratio_interval(ar), interval_text=ratio_text(ar),
-                             vacuous=frozen(ar and ar.get("theta_moved")))
+                             vacuous=frozen(ar.get("theta_moved") if ar else None))
             out = output(c.name, "improvement_ratio") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/improvement-ratio", group=group,
                   quantity=f"improvement ratio, {method}",
@@ -387,7 +382,8 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
                   vacuous=frozen(r.get("theta_moved")),
                   fields={"method": c.name, "quantity": "improvement_ratio"},
                   authors=replace(a_col, note=authors_note),
-                  slip_note="" if out is None else _slip(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%", 100),
+                  slip_note="" if out is None else slip_sentence(out, f"{100 * thesis:.6g}", lambda v: f"{v:.4g}%",
+                                                                 100),
                   remark=_missing(out) or _also(also, other, "improvement_ratio", pct, f"{100 * thesis:.6g}", 100),
                   output=out, note_values=note_values))
 
@@ -464,7 +460,7 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
               page="lqg2d", heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
               interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
               expected_seeds=seeds, authors=replace(a_col, note=note),
-              slip_note=_slip(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
+              slip_note=slip_sentence(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
                exponent=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
@@ -581,7 +577,8 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
     """
     _table_5_1_rows(b, exps["table-5.1"], reps["table-5.1"], exps["table-5.1-printed-theta0"],
                     reps["table-5.1-printed-theta0"], exps.get("table-5.1-authors"), reps.get("table-5.1-authors"),
-                    tail_placement(exps.get("table-5.1-authors-tail"), recs.get("table-5.1-authors-tail", {})))
+                    tail_placement(exps.get("table-5.1-authors-tail"), recs.get("table-5.1-authors-tail", {})),
+                    exps.get("table-5.1-authors-tail"), reps.get("table-5.1-authors-tail"))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
                     reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",

@@ -17,14 +17,12 @@ function safepgCartpoleSettings(p) {
 const safepgCartpolePage = {
   configs(p, data) {
     const task = data.tasks[data.task_boxes.map(b => p[b] ? "1" : "0").join("")];
-    const common = {theta0: data.starts[p.start], sigma: p.sigma, estimator: "gpomdp", baseline: true,
-                    score: "clipped", bound: "bernstein", empiricalRange: true, delta: p.delta, budget: +p.budget,
-                    seed: Math.round(p.seed)};
-    const adaptive = {...common, algorithm: "adaptive", nMin: 100, nMax: 500000, nFirst: null, constants: "bounds",
-                      statistics: "component", stepWhenUnsafe: false, stream: 0};
-    // Each ticked box's options, already under the learner's names (js_tasks.learner_options).
+    const run = {theta0: data.starts[p.start], sigma: p.sigma, budget: +p.budget, seed: Math.round(p.seed)};
+    // The methods as safepg holds them, under the page learner's names (option_names.learner_options),
+    // then each ticked box's options.
+    const adaptive = {...data.adaptive, ...run, delta: p.delta, stream: 0};
     for (const [box, opts] of Object.entries(data.settings)) if (p[box]) Object.assign(adaptive, opts);
-    const vanilla = {...common, algorithm: "vanilla", ...data.vanilla, stopOnDivergence: true, stream: 1};
+    const vanilla = {...data.vanilla, ...run, stopOnDivergence: true, stream: 1};
     return {task: task, runs: [{name: "adaptive", cfg: adaptive}, {name: "vanilla", cfg: vanilla}]};
   },
   result(p, st, data) {

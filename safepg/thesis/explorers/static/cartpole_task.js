@@ -12,7 +12,7 @@
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
   /** safepg's CartPole() field by field (camelCase); polemassLength and constantsGamma null as there. */
   const CARTPOLE_DEFAULT = Object.freeze({
     kind: "cartpole", poleLength: 1.0, gamma: 0.99, H: 200, angleThresholdDeg: 41.8, xThreshold: 2.4,
@@ -86,14 +86,14 @@
    * states (s[i * n + j]); src.step(z, live, 1, t, idx) the normals of the live episodes
    * (idx: their indices in the batch). Returns [R, M_phi] measured on the batch: 1 and the
    * largest |state component| visited (initial and final states included), as
-   * CartPole.gradient_batch_maxima.
+   * CartPole.gradient_batch_constants.
    */
   CartpoleBatch.prototype.run = function (theta, sigma, n, opt, src) {
     const task = this.task, H = this.H, ph = physics(task);
     const half = ph.half, ml = ph.ml, total = ph.total, pm = ph.poleMass, grav = ph.gravity, tau = ph.tau;
     const semi = ph.semi, ab = task.actionBound, xt = task.xThreshold;
     const at = task.angleThresholdDeg * Math.PI / 180;  // math.radians
-    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.scoreAction !== "raw";
     const gb = baseline && !reinforce, w = reinforce ? 0.0 : 1.0;
     this.grow(n);
     const cap = this.cap, S = this.S, z = this.z, idx = this.idx, disc = this.disc, b = this.b;

@@ -118,14 +118,14 @@ function safepgLiveLearner(root, spec, learnerSrc) {
     return p;
   }
   function configs(p) {
-    const common = {sigma: p.sigma, estimator: p.estimator, baseline: p.baseline === "on", score: p.score,
+    // The options under safepg.options' names (options.js); the rest are their defaults.
+    const common = {sigma: p.sigma, estimator: p.estimator, baseline: p.baseline === "on", scoreAction: p.score,
                     budget: +p.budget, seed: Math.round(p.seed), theta0: 0};
-    const b = p.bound.replace("-er", "");
-    const runs = [{name: "adaptive", cfg: {...common, algorithm: "adaptive", bound: b, delta: p.delta,
-                                           empiricalRange: p.bound.endsWith("-er"), nMin: 100, nMax: 500000,
+    const runs = [{name: "adaptive", cfg: {...common, method: "Adaptive", bound: p.bound.replace("-er", ""),
+                                           delta: p.delta, range: p.bound.endsWith("-er") ? "empirical" : "lemma",
                                            stream: 0}}];
     if (p.vanilla_n !== "off")
-      runs.push({name: "vanilla", cfg: {...common, algorithm: "vanilla", batchSize: +p.vanilla_n,
+      runs.push({name: "vanilla", cfg: {...common, method: "Vanilla", batchSize: +p.vanilla_n, step: "FixedStep",
                                         alpha: +p.vanilla_alpha, stream: 1}});
     return runs;
   }

@@ -1,10 +1,14 @@
 // The 2-D LQG explorers' page objects (lqg2d_learner.py: steps_configs/steps_result and
 // adaptive_configs/adaptive_result are their Python twins, rule for rule).
 function safepgLqg2dBound(p) { return [p.bound.replace("-er", ""), p.bound.endsWith("-er")]; }
+// The options under safepg.options' names (options.js); the rest are their defaults.
 function safepgLqg2dCommon(p, data) {
+  return {theta0: data.theta0, sigma: p.sigma, estimator: "gpomdp", baseline: true, scoreAction: "clipped",
+          budget: +p.budget, seed: Math.round(p.seed)};
+}
+function safepgLqg2dError(p) {
   const [bound, er] = safepgLqg2dBound(p);
-  return {theta0: data.theta0, sigma: p.sigma, estimator: "gpomdp", baseline: true, score: "clipped",
-          bound: bound, empiricalRange: er, delta: p.delta, budget: +p.budget, seed: Math.round(p.seed)};
+  return {bound: bound, range: er ? "empirical" : "lemma", delta: p.delta};
 }
 function safepgLqg2dTaskCheck(data) {
   if (data.task.missing) throw new Error(`the JavaScript engine for the 2-D LQG is missing (${data.task.missing})`);
@@ -13,8 +17,8 @@ const safepgLqg2dSteps = {
   configs(p, data) {
     safepgLqg2dTaskCheck(data);
     const runs = ["scalar", "coordinate"].map((step, k) => ({name: step, cfg: {
-      ...safepgLqg2dCommon(p, data), algorithm: "vanilla", batchSize: +p.n, alpha: null, step: step,
-      stopOnDivergence: true, stream: k}}));
+      ...safepgLqg2dCommon(p, data), ...safepgLqg2dError(p), method: "Vanilla", batchSize: +p.n, step: "SafeStep",
+      kind: step, stopOnDivergence: true, stream: k}}));
     return {task: data.task, runs: runs};
   },
   result(p, st, data) {
@@ -46,15 +50,12 @@ const safepgLqg2dAdaptive = {
   configs(p, data) {
     safepgLqg2dTaskCheck(data);
     const common = safepgLqg2dCommon(p, data);
-    const adaptive = {...common, algorithm: "adaptive", nMin: 100, nMax: +p.n_max, stream: 0,
-                      statistics: "component", stepWhenUnsafe: false, nFirst: null};
-    if (p.authors) Object.assign(adaptive, {statistics: data.authors.statistics,
-                                            stepWhenUnsafe: data.authors.stepWhenUnsafe,
-                                            nFirst: data.authors.nFirst});
+    const adaptive = {...common, ...safepgLqg2dError(p), method: "Adaptive", nMin: 100, nMax: +p.n_max, stream: 0};
+    if (p.authors) Object.assign(adaptive, data.authors);  // maxima, unguardedStep, first
     const runs = [{name: "adaptive", cfg: adaptive}];
     for (const [name, n] of [["N=1000", 1000], ["N=100", 100]])
-      runs.push({name: name, cfg: {...common, algorithm: "vanilla", batchSize: n, alpha: 1e-6, step: "scalar",
-                                   stopOnDivergence: true, stream: runs.length}});
+      runs.push({name: name, cfg: {...common, method: "Vanilla", batchSize: n, step: "FixedStep", alpha: 1e-6,
+                                   kind: "scalar", stopOnDivergence: true, stream: runs.length}});
     return {task: data.task, runs: runs};
   },
   result(p, st, data) {

@@ -67,7 +67,7 @@
     batch.constants2(theta, sigma, new Float64Array(buf, k.io.cf, 24));
     const state = new Int32Array(buf, k.io.rng, 4);
     state.set(src.rng.s);
-    const maxima = opt.constants === "batch";
+    const maxima = opt.batchConstants;
     k.ex.lqg2_gpomdp_baseline(n, task.H, maxima ? 1 : 0, at.z, at.st, at.samples, at.returns);
     src.rng.s.set(state);
     batch.samples.set(new Float64Array(buf, at.samples, 4 * n));

@@ -10,7 +10,7 @@
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
   function asMatrix(x, m, name) {
     if (typeof x === "number") {
       const out = new Float64Array(m * m);
@@ -208,16 +208,21 @@
    * n gradient samples (this.samples, component p of trajectory j at p * n + j) and discounted
    * returns (this.returns) with gain theta. src.init(s, n, m, lo, hi) fills the initial states
    * (s[i * n + j] uniform in [lo, hi)); src.step(z, n, m, t, idx) the step's standard normals.
-   * Returns, with opt.constants = "batch", the batch's [max |r_t|, max |s_i|] over its steps
+   * Returns, with opt.batchConstants, the batch's [max |r_t|, max |s_i|] over its steps
    * (what safepg.learning measures on a simulated batch), else null.
    */
   LqgBatch.prototype.run = function (theta, sigma, n, opt, src) {
     this.kernel = "javascript";  // which code computed the last batch (run2 may say "webassembly")
+    if (this.m === 1) return this.run1(theta, sigma, n, opt, src);
     if (this.m === 2) return this.run2(theta, sigma, n, opt, src);
+    return this.runM(theta, sigma, n, opt, src);
+  };
+  /** run() in any dimension: the generic loop that run1 and run2 unroll (the tests compare them). */
+  LqgBatch.prototype.runM = function (theta, sigma, n, opt, src) {
     const task = this.task, m = this.m, M = this.M, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
     const A = task.A, B = task.B, Q = task.Q, R = task.R;
-    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.scoreAction !== "raw";
     this.grow(n);
     const s = this.s, z = this.z, G = this.G, samples = this.samples, acc = this.acc, returns = this.returns;
     const num = this.num, den = this.den, b = this.b;
@@ -227,7 +232,7 @@
     G.fill(0, 0, M * n); samples.fill(0, 0, M * n); acc.fill(0, 0, M * n); returns.fill(0, 0, n);
     num.fill(0); den.fill(0);
     let disc = 1.0, rmax = 0, fmax = 0;
-    const maxima = opt.constants === "batch";
+    const maxima = opt.batchConstants;
     for (let t = 0; t < H; t++) {
       src.step(z, n, m, t, this.idx);
       const to = t * M;
@@ -283,13 +288,69 @@
   };
 
   /**
+   * run() for m = 1 (the LQG of Section 5.1): the generic loop's operations in the generic loop's
+   * order, so the same bits, but one trajectory at a time with its state in locals (several times
+   * faster). Each sum over trajectories still runs in trajectory order, and each sum over steps in
+   * step order, as there. The step normals are drawn first, step by step as runM draws them, into
+   * an (H, n) array whose cells then keep each trajectory's score for the baseline.
+   */
+  LqgBatch.prototype.run1 = function (theta, sigma, n, opt, src) {
+    const task = this.task, H = task.H, gamma = task.gamma;
+    const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
+    const A = task.A[0], B = task.B[0], Q = task.Q[0], R = task.R[0], th = theta[0];
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.scoreAction !== "raw";
+    this.grow(n);
+    if (!this.zh || this.zh.length < H * n) this.zh = new Float64Array(H * this.cap);
+    const s = this.s, zh = this.zh, samples = this.samples, returns = this.returns, G = this.G;
+    const num = this.num, den = this.den, b = this.b;
+    const invVar = 1.0 / (sigma * sigma);
+    src.init(s, n, 1, -bs, bs);
+    for (let t = 0; t < H; t++) src.step(zh.subarray(t * n, t * n + n), n, 1, t, this.idx);
+    num.fill(0); den.fill(0);
+    const maxima = opt.batchConstants;
+    let rmax = 0, fmax = 0;
+    for (let j = 0; j < n; j++) {
+      let sj = s[j], g = 0.0, sample = 0.0, ret = 0.0, disc = 1.0;
+      for (let t = 0, o = j; t < H; t++, o += n) {
+        const mean = 0.0 + th * sj;
+        const araw = mean + sigma * zh[o];
+        const u = clip ? Math.min(Math.max(araw, -ba), ba) : araw;
+        const cost = 0.0 + (sj * Q * sj + u * R * u);
+        const dr = -0.5 * cost * disc;
+        ret += dr;
+        if (maxima) {
+          rmax = Math.max(rmax, Math.abs(-0.5 * cost));
+          fmax = Math.max(fmax, Math.abs(sj));
+        }
+        g = g + invVar * ((scoreClipped ? u : araw) - mean) * sj;
+        if (!reinforce) { sample += g * dr; num[t] += g * g * dr; den[t] += g * g; zh[o] = g; }
+        const next = 0.0 + (A * sj + B * u);
+        sj = clip ? Math.min(Math.max(next, -bs), bs) : next;
+        disc *= gamma;
+      }
+      returns[j] = ret; G[j] = g; samples[j] = sample;
+    }
+    if (reinforce) {
+      reinforceSamples(G, returns, samples, n, 1, baseline);
+    } else if (baseline) {
+      for (let t = 0; t < H; t++) b[t] = den[t] !== 0 ? num[t] / den[t] : 0;
+      for (let j = 0; j < n; j++) {
+        let acc = 0.0;
+        for (let t = 0, o = j; t < H; t++, o += n) acc += zh[o] * b[t];
+        samples[j] -= acc;
+      }
+    }
+    return maxima ? [rmax, fmax] : null;
+  };
+
+  /**
    * run() for m = 2 with the 2 x 2 algebra unrolled (the 2-D kernel of safepg): the same sums
    * in the same order as the generic loop, so the same bits, about three times faster. The
    * figures' case goes to the WebAssembly kernel of lqg2d_wasm.js when the run draws its own
    * numbers (the same bits again), else to run2gb.
    */
   LqgBatch.prototype.run2 = function (theta, sigma, n, opt, src) {
-    if (opt.estimator !== "reinforce" && opt.baseline && opt.score !== "raw" && this.task.clip !== false) {
+    if (opt.estimator !== "reinforce" && opt.baseline && opt.scoreAction !== "raw" && this.task.clip !== false) {
       const found = L.lqg2dWasm ? L.lqg2dWasm.run(this, theta, sigma, n, opt, src) : undefined;
       if (found === undefined) return this.run2gb(theta, sigma, n, opt, src);
       this.kernel = "webassembly";
@@ -297,7 +358,7 @@
     }
     const task = this.task, H = task.H, gamma = task.gamma;
     const bs = task.stateBound, ba = task.actionBound, clip = task.clip !== false;
-    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.score !== "raw";
+    const reinforce = opt.estimator === "reinforce", baseline = !!opt.baseline, scoreClipped = opt.scoreAction !== "raw";
     this.grow(n);
     const s = this.s, z = this.z, G = this.G, samples = this.samples, acc = this.acc, returns = this.returns;
     const [k00, k01, k10, k11] = theta, [a00, a01, a10, a11] = task.A, [b00, b01, b10, b11] = task.B;
@@ -306,7 +367,7 @@
     src.init(s, n, 2, -bs, bs);
     G.fill(0, 0, 4 * n); samples.fill(0, 0, 4 * n); acc.fill(0, 0, 4 * n); returns.fill(0, 0, n);
     let disc = 1.0, rmax = 0, fmax = 0;
-    const maxima = opt.constants === "batch";
+    const maxima = opt.batchConstants;
     // The baseline term of step t - 1 (b of the previous step, 0 at t = 0) joins step t's pass over
     // the batch: the same terms added in the same order as a pass of their own, one pass fewer.
     const gb = !reinforce && baseline;
@@ -399,7 +460,7 @@
     st.fill(0, 0, end);
     for (let j = 0, o = 0; j < n; j++, o += ST) { st[o] = s[j]; st[o + 1] = s[n + j]; }
     let disc = 1.0, rmax = 0, fmax = 0;
-    const maxima = opt.constants === "batch";
+    const maxima = opt.batchConstants;
     // b_t - 1 (0 at t = 0) times the score before step t joins step t's pass, as in run2.
     let b0 = 0, b1 = 0, b2 = 0, b3 = 0;
     for (let t = 0; t < H; t++) {

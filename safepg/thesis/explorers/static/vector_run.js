@@ -1,20 +1,70 @@
 /*
- * Algorithm 4.1 and vanilla policy gradient on a vector theta (safepg.learning.adaptive_pg /
- * vanilla_pg): the LQG of lqg_task.js in m > 1 dimensions and the cart-pole of
- * cartpole_task.js, with the authors' options (constants measured per batch, statistics as
- * maxima over components, the unguarded step) and the fixed-N steps of Section 5.2.1 (the
- * scalar step of [24], the coordinate step Lambda*). The 1-D LQG keeps learner.js's Run, so
- * a seeded 1-D run gives the numbers it always did. Concatenated last (it extends safepgLearner
- * and widens Driver.makeRun to every task).
+ * Algorithm 4.1 and vanilla policy gradient (safepg.learning.adaptive_pg / vanilla_pg) on every
+ * task of the page: the LQG of lqg_task.js in any dimension (the 1-D LQG of Section 5.1 is m = 1)
+ * and the cart-pole of cartpole_task.js, with the authors' departures (constants measured per
+ * batch, maxima over components, the unguarded step) and the fixed-N steps of Section 5.2.1 (the
+ * scalar step of [24], the coordinate step Lambda*). A run's configuration uses the option
+ * objects' own names (options.js, generated from safepg.options). Concatenated last (it extends
+ * safepgLearner and sets Driver.makeRun).
  */
 "use strict";
 (function (L) {
-  function check(cond, msg) { if (!cond) throw new RangeError(msg); }
-  const VECTOR_DEFAULTS = Object.freeze({
-    algorithm: "adaptive", theta0: 0, sigma: 1, estimator: "gpomdp", baseline: true, bound: "chebyshev",
-    delta: 0.95, empiricalRange: false, theoreticalRange: null, nMin: 100, nMax: 500000, nFirst: null,
-    budget: 1000000, score: "clipped", constants: "bounds", statistics: "component", stepWhenUnsafe: false,
-    batchSize: 100, alpha: 1e-3, step: "scalar", stopOnDivergence: true, seed: 0, stream: 0});
+  const check = L.check;  // learner.js's: one argument check for every file of the learner
+  const O = L.OPTIONS;  // options.js: every option's name, default and allowed values
+  /** The page's own settings beside the run's options: the stream of a seed (its runs draw apart). */
+  const PAGE_FIELDS = Object.freeze({stream: 0});
+
+  function allowed(e, v) {
+    if (e.types) return e.types.includes(v) || (v === null && !!e.nullable);
+    if (v === null) return !!e.nullable;
+    if (e.choices && e.choices.includes(v)) return true;
+    if (e.integer && Number.isInteger(v)) return true;
+    if (e.number && typeof v === "number" && !Number.isNaN(v)) return true;
+    return !!e.list && (Array.isArray(v) || ArrayBuffer.isView(v));
+  }
+  function describe(e) {
+    const kinds = [];
+    if (e.types) kinds.push(...e.types.map(t => JSON.stringify(t)));
+    if (e.choices) kinds.push(...e.choices.map(c => JSON.stringify(c)));
+    if (e.integer) kinds.push("an integer");
+    if (e.number) kinds.push("a number");
+    if (e.list) kinds.push("a list of numbers");
+    if (e.nullable) kinds.push("null");
+    return kinds.join(" or ");
+  }
+  /**
+   * A run's configuration completed from the option table: every option of its method (method:
+   * "Adaptive" or "Vanilla", the types' names of safepg.options), each given or its default.
+   * A name that is no option of this run, a value outside an option's values, or a missing
+   * required option throws, naming it.
+   */
+  function runOptions(cfgIn) {
+    const given = cfgIn || {};
+    const cfg = {method: given.method === undefined ? "Adaptive" : given.method, ...PAGE_FIELDS};
+    check(O.methods.includes(cfg.method), `method must be one of ${O.methods.join(", ")}, got ${cfg.method}`);
+    const known = new Set(["method", ...Object.keys(PAGE_FIELDS)]);
+    if ("stream" in given) cfg.stream = given.stream;
+    const fill = (name, e) => {
+      known.add(name);
+      const v = name in given ? given[name] : e.default;
+      check(v !== undefined, `${name} is required for a ${cfg.method} run`);
+      check(allowed(e, v), `${name} must be ${describe(e)}, got ${JSON.stringify(v)}`);
+      cfg[name] = v;
+      return v;
+    };
+    const visit = type => {
+      for (const [name, e] of Object.entries(O.types[type])) {
+        if (e.nested) visit(e.types[0]);
+        else if (e.types) { const t = fill(name, e); if (t !== null) visit(t); }
+        else fill(name, e);
+      }
+    };
+    visit(cfg.method);
+    for (const [name, e] of Object.entries(O.run)) fill(name, e);
+    for (const name of Object.keys(given))
+      check(known.has(name), `${name} is not an option of this ${cfg.method} run (its options: ${[...known].join(", ")})`);
+    return cfg;
+  }
 
   /** The bound constants of a task (TaskConstants.from_task): the discount is constantsGamma when set. */
   function taskConstants(task, sigma) {
@@ -27,44 +77,17 @@
     return {R: task.rewardBound, M: task.featureBound, Avol: task.actionVolume, Abar: task.actionBound,
             gamma: task.gamma, H: task.H, sigma: sigma, horizonTerm: "effective"};
   }
-  /** safepg.meta.penalty_constant, the horizon factor h of TaskConstants.horizon_term included. */
-  function penaltyConstantH(k) {
-    if (!k.horizonTerm || k.horizonTerm === "effective") return L.penaltyConstant(k);
-    const g = k.gamma, s = k.sigma;
-    const h = k.horizonTerm === "horizon" || g === 1 ? k.H : (1 - Math.pow(g, k.H)) / (1 - g);
-    return k.R * (k.M * k.M) * (h * h) / (s * s) * (k.Avol / (Math.sqrt(2 * Math.PI) * s) + g * h / 2);
-  }
   /** safepg.meta.scalar_step: the step of [24], ||(|g| - eps)+||_2^2 / (2 c ||(|g| + eps)||_1^2). */
   function scalarStep(grad, e, c) {
     let lo2 = 0, up = 0;
     for (const v of grad) { const a = Math.abs(v), lo = Math.max(a - e, 0); lo2 += lo * lo; up += a + e; }
     return up === 0 ? 0 : lo2 / (2 * c * (up * up));
   }
-  /** safepg.meta.coordinate_step, guarded (0 when eps >= g) unless stepWhenUnsafe. */
-  function coordinateStepU(g, e, c, guarded) {
-    if (e >= g && guarded) return 0;
-    const lo = g - e, hi = g + e;
-    return hi === 0 ? 0 : lo * lo / (2 * c * (hi * hi));
-  }
   /** Sample variance (ddof = 1) and range of row p of an (m, n) component-major array. */
   function rowStats(x, p, n, scratch) {
     const row = x.subarray(p * n, p * n + n);
     return {variance: L.sampleVariance(row, n, scratch), range: L.range(row, n)};
   }
-  /**
-   * safepg.bounds.error_bound on component p with the overrides of statistics="max"
-   * (spread: {variance, range} or null).
-   */
-  function errorBoundN(cfg, x, p, n, k, scratch, spread, theoreticalRange) {
-    const row = x.subarray(p * n, p * n + n);
-    if (cfg.bound === "chebyshev")
-      return L.chebyshev(cfg.delta, cfg.estimator === "reinforce" ? L.reinforceVarianceFactor(k) : L.gpomdpVarianceFactor(k));
-    const R = cfg.empiricalRange ? (spread ? spread.range : L.range(row, n))
-      : (theoreticalRange != null ? theoreticalRange : L.gradientRangeBound(k));
-    if (cfg.bound === "hoeffding") return L.hoeffding(cfg.delta, R);
-    return L.bernstein(cfg.delta, spread ? spread.variance : L.sampleVariance(row, n, scratch), R);
-  }
-
   /** The random numbers of a run from its own generator (learner.js's Rng). */
   function rngSource(rng) {
     return {
@@ -96,52 +119,47 @@
     };
   }
 
+  /** The checks of the option objects' __post_init__ that the table cannot state; the first batch's size. */
   function checkCfg(cfg, m) {
-    check(cfg.algorithm === "adaptive" || cfg.algorithm === "vanilla", `algorithm must be adaptive or vanilla, got ${cfg.algorithm}`);
-    check(cfg.delta > 0 && cfg.delta < 1, `delta must be in (0, 1), got ${cfg.delta}`);
+    check(cfg.target === undefined || cfg.target === null, "target: the page learner runs no target protocol");
+    if (cfg.delta !== undefined) check(cfg.delta > 0 && cfg.delta < 1, `delta must be in (0, 1), got ${cfg.delta}`);
     check(cfg.sigma > 0 && isFinite(cfg.sigma), `sigma must be finite and > 0, got ${cfg.sigma}`);
-    check(cfg.estimator === "gpomdp" || cfg.estimator === "reinforce", `estimator must be gpomdp or reinforce, got ${cfg.estimator}`);
-    check(["chebyshev", "hoeffding", "bernstein"].includes(cfg.bound), `bound must be chebyshev, hoeffding or bernstein, got ${cfg.bound}`);
-    check(cfg.score === "clipped" || cfg.score === "raw", `score must be clipped or raw, got ${cfg.score}`);
-    check(cfg.constants === "bounds" || cfg.constants === "batch", `constants must be bounds or batch, got ${cfg.constants}`);
-    check(cfg.statistics === "component" || cfg.statistics === "max", `statistics must be component or max, got ${cfg.statistics}`);
-    check(cfg.step === "scalar" || cfg.step === "coordinate", `step must be scalar or coordinate, got ${cfg.step}`);
-    check(typeof cfg.stepWhenUnsafe === "boolean", `stepWhenUnsafe must be true or false, got ${cfg.stepWhenUnsafe}`);
-    check(typeof cfg.stopOnDivergence === "boolean", `stopOnDivergence must be true or false, got ${cfg.stopOnDivergence}`);
-    check(cfg.theoreticalRange == null || (isFinite(cfg.theoreticalRange) && cfg.theoreticalRange > 0),
-          `theoreticalRange must be finite and > 0 or null, got ${cfg.theoreticalRange}`);
+    if (typeof cfg.range === "number")
+      check(isFinite(cfg.range) && cfg.range > 0, `range must be "lemma", "empirical" or finite and > 0, got ${cfg.range}`);
     const th = Array.isArray(cfg.theta0) || ArrayBuffer.isView(cfg.theta0) ? Array.from(cfg.theta0) : null;
     check(th === null ? Number.isFinite(cfg.theta0) : th.length === m && th.every(Number.isFinite),
           `theta0 must be a finite number or ${m} finite numbers, got ${cfg.theta0}`);
     let first;
-    if (cfg.algorithm === "adaptive") {
-      check(Number.isInteger(cfg.nMin) && cfg.nMin >= 2, `nMin must be an integer >= 2, got ${cfg.nMin}`);
+    if (cfg.method === "Adaptive") {
+      check(cfg.nMin >= 2, `nMin must be an integer >= 2, got ${cfg.nMin}`);
       check(cfg.nMin <= cfg.nMax, `nMin must be <= nMax, got ${cfg.nMin} > ${cfg.nMax}`);
-      check(cfg.nFirst == null || (Number.isInteger(cfg.nFirst) && cfg.nFirst >= 2), `nFirst must be an integer >= 2 or null, got ${cfg.nFirst}`);
-      first = cfg.nFirst == null ? cfg.nMin : cfg.nFirst;
+      check(cfg.first === null || cfg.first >= 2, `first must be an integer >= 2 or null, got ${cfg.first}`);
+      first = cfg.first === null ? cfg.nMin : cfg.first;
     } else {
-      check(Number.isInteger(cfg.batchSize) && cfg.batchSize >= 2, `batchSize must be an integer >= 2, got ${cfg.batchSize}`);
-      check(cfg.alpha === null || (isFinite(cfg.alpha) && cfg.alpha >= 0), `alpha must be finite and >= 0 or null, got ${cfg.alpha}`);
+      check(cfg.batchSize >= 2, `batchSize must be an integer >= 2, got ${cfg.batchSize}`);
+      if (cfg.step === "FixedStep") check(isFinite(cfg.alpha) && cfg.alpha >= 0, `alpha must be finite and >= 0, got ${cfg.alpha}`);
       first = cfg.batchSize;
     }
-    check(Number.isInteger(cfg.budget) && cfg.budget >= first, `budget must be an integer >= the first batch size ${first}, got ${cfg.budget}`);
+    check(cfg.budget >= first, `budget must be an integer >= the first batch size ${first}, got ${cfg.budget}`);
     return first;
   }
 
   /**
-   * A learning run on a vector task, one iteration at a time (learner.js's Run, for theta in R^m).
+   * A learning run, one iteration at a time (so a worker can report progress and be stopped
+   * between batches). cfg: see runOptions; task: lqgTask or cartpoleTask; src: the random numbers
+   * (rngSource of the cfg's seed and stream by default).
    * rec: batchSize, alpha, coordinate, eps, Jhat, grad (arrays), safe, nextN, c (I each);
    * theta (arrays) and J (closed form for the LQG, null for the cart-pole) (I + 1).
    */
   function VectorRun(cfgIn, task, src) {
-    const cfg = Object.assign({}, VECTOR_DEFAULTS, cfgIn);
+    const cfg = runOptions(cfgIn);
     check(task && (task.kind === "lqg" || task.kind === "cartpole"), `task.kind must be lqg or cartpole, got ${task && task.kind}`);
     const m = task.kind === "lqg" ? task.dim * task.dim : 4;
     const first = checkCfg(cfg, m);
     this.cfg = cfg; this.task = task; this.m = m;
     this.batch = task.kind === "lqg" ? new L.LqgBatch(task) : new L.CartpoleBatch(task);
     this.k = taskConstants(task, cfg.sigma);
-    this.c = penaltyConstantH(this.k);
+    this.c = L.penaltyConstant(this.k);
     this.src = src || rngSource(new L.Rng(cfg.seed, cfg.stream));
     const th = Array.isArray(cfg.theta0) || ArrayBuffer.isView(cfg.theta0) ? cfg.theta0 : null;
     this.theta = Float64Array.from({length: m}, (_, i) => (th ? th[i] : cfg.theta0));
@@ -150,7 +168,7 @@
     this.rec = {batchSize: [], alpha: [], coordinate: [], eps: [], Jhat: [], grad: [], safe: [], nextN: [], c: [],
                 theta: [this.vec(this.theta)], J: [this.performance()]};
   }
-  /** A vector as the record keeps it: an array, or a number on the 1-D LQG (as learner.js's Run). */
+  /** A vector as the record keeps it: an array, or a number on the 1-D LQG. */
   VectorRun.prototype.vec = function (v) { return this.m === 1 ? v[0] : Array.from(v); };
   VectorRun.prototype.performance = function () {
     if (this.task.kind !== "lqg") return null;
@@ -165,30 +183,39 @@
     if (n < 2) { this.done = true; return false; }
     const found = bt.run(this.theta, cfg.sigma, n, cfg, this.src);
     this.kernel = bt.kernel || "javascript";
-    const x = bt.samples, grad = this.grad;
-    // numpy's samples.sum(axis=0) adds the rows one after the other.
-    let finite = true;
-    for (let p = 0; p < m; p++) {
-      let acc = 0.0;
-      for (let j = 0, o = p * n; j < n; j++) acc += x[o + j];
-      grad[p] = acc / n;
-      if (!isFinite(grad[p])) finite = false;
-    }
-    if (!finite) {
+    const x = bt.samples;
+    if (!this.gradient(x, n)) {
       if (!cfg.stopOnDivergence) throw new RangeError(`gradient estimate is not finite at theta=${Array.from(this.theta)}`);
       this.done = this.diverged = true;
       return false;
     }
     const Jhat = L.pairwiseSum(bt.returns, 0, n) / n;
-    const up = cfg.algorithm === "adaptive" ? this.adaptive(x, n, found) : this.vanilla(x, n);
+    const up = cfg.method === "Adaptive" ? this.adaptive(x, n, found) : this.vanilla(x, n);
     for (let p = 0; p < m; p++) this.theta[p] += up.step[p];
     this.used += n;
     const r = this.rec;
     r.batchSize.push(n); r.alpha.push(up.alpha); r.coordinate.push(up.k); r.eps.push(up.eps); r.Jhat.push(Jhat);
-    r.grad.push(this.vec(grad)); r.safe.push(up.safe); r.nextN.push(up.nextN); r.c.push(up.c);
+    r.grad.push(this.vec(this.grad)); r.safe.push(up.safe); r.nextN.push(up.nextN); r.c.push(up.c);
     r.theta.push(this.vec(this.theta)); r.J.push(this.performance());
     this.n = up.nextN;
     return true;
+  };
+  /**
+   * this.grad: the mean of the batch's samples x (component p of trajectory j at p * n + j) as
+   * safepg computes it, samples.sum(axis=0) / n. numpy sums an (n, 1) array pairwise and an
+   * (n, m) array row after row; true when every component is finite.
+   */
+  VectorRun.prototype.gradient = function (x, n) {
+    const m = this.m, grad = this.grad;
+    let finite = true;
+    for (let p = 0; p < m; p++) {
+      let acc = 0.0;
+      if (m === 1) acc = L.pairwiseSum(x, 0, n);
+      else for (let j = 0, o = p * n; j < n; j++) acc += x[o + j];
+      grad[p] = acc / n;
+      if (!isFinite(grad[p])) finite = false;
+    }
+    return finite;
   };
   function argmaxAbs(grad) {
     let k = 0;
@@ -199,12 +226,12 @@
   VectorRun.prototype.adaptive = function (x, n, found) {
     const cfg = this.cfg, m = this.m, grad = this.grad, k = argmaxAbs(grad), g = Math.abs(grad[k]);
     let kc = this.k, c = this.c;
-    if (cfg.constants === "batch") {
+    if (cfg.batchConstants) {
       kc = Object.assign({}, this.k, {R: found[0], M: found[1]});
-      c = penaltyConstantH(kc);
+      c = L.penaltyConstant(kc);
     }
     let spread = null;
-    if (cfg.statistics === "max") {
+    if (cfg.maxima) {
       spread = {variance: -Infinity, range: -Infinity};
       for (let p = 0; p < m; p++) {
         const st = rowStats(x, p, n, this.batch.scratch);
@@ -212,9 +239,9 @@
         spread.range = Math.max(spread.range, st.range);
       }
     }
-    const bd = errorBoundN(cfg, x, k, n, kc, this.batch.scratch, spread, cfg.theoreticalRange);
+    const bd = L.errorBound(cfg, x.subarray(k * n, k * n + n), n, kc, this.batch.scratch, spread);
     const e = L.eps(bd, n);
-    const alpha = coordinateStepU(g, e, c, !cfg.stepWhenUnsafe);
+    const alpha = L.coordinateStep(g, e, c, !cfg.unguardedStep);
     const step = new Float64Array(m);
     step[k] = alpha * grad[k];
     return {step, alpha, k, eps: e, safe: e < g, c, d: bd.d, f: bd.f,
@@ -222,44 +249,22 @@
   };
   /** The rule of safepg.learning.vanilla_pg. */
   VectorRun.prototype.vanilla = function (x, n) {
-    const cfg = this.cfg, m = this.m, grad = this.grad, k = argmaxAbs(grad);
+    const cfg = this.cfg, m = this.m, grad = this.grad, k = argmaxAbs(grad), scalar = cfg.kind === "scalar";
     let e = 0, safe = true, a = cfg.alpha;
-    if (a === null) {
+    if (cfg.step === "SafeStep") {
       e = -Infinity;  // one eps for every component: the largest per-component bound
-      for (let p = 0; p < m; p++) e = Math.max(e, L.eps(errorBoundN(cfg, x, p, n, this.k, this.batch.scratch, null, null), n));
+      for (let p = 0; p < m; p++) e = Math.max(e, L.eps(L.errorBound(cfg, x.subarray(p * n, p * n + n), n, this.k, this.batch.scratch), n));
       safe = e < Math.abs(grad[k]);
-      a = cfg.step === "scalar" ? scalarStep(grad, e, this.c) : coordinateStepU(Math.abs(grad[k]), e, this.c, true);
+      a = scalar ? scalarStep(grad, e, this.c) : L.coordinateStep(Math.abs(grad[k]), e, this.c, true);
     }
     const step = new Float64Array(m);
-    if (cfg.step === "scalar") for (let p = 0; p < m; p++) step[p] = a * grad[p];
+    if (scalar) for (let p = 0; p < m; p++) step[p] = a * grad[p];
     else step[k] = a * grad[k];
-    return {step, alpha: a, k: cfg.step === "scalar" ? -1 : k, eps: e, safe, c: this.c, nextN: cfg.batchSize};
+    return {step, alpha: a, k: scalar ? -1 : k, eps: e, safe, c: this.c, nextN: cfg.batchSize};
   };
   VectorRun.prototype.finish = function () { while (this.step()); return this; };
 
-  /** The 1-D task of learner.js's Run from an lqgTask(dim: 1). */
-  function oneDTask(task) {
-    return {gamma: task.gamma, H: task.H, bs: task.stateBound, ba: task.actionBound, A: task.A[0], B: task.B[0],
-            Q: task.Q[0], Rc: task.R[0], R: task.rewardBound, M: task.featureBound, Avol: task.actionVolume,
-            Abar: task.actionBound, clip: task.clip};
-  }
-  /** Whether a cfg sets an option learner.js's 1-D Run does not have. */
-  function needsVectorRun(cfg) {
-    const d = VECTOR_DEFAULTS, c = cfg || {};
-    return ["nFirst", "constants", "statistics", "stepWhenUnsafe", "step", "stopOnDivergence"]
-      .some(k => c[k] !== undefined && c[k] !== d[k]) || c.alpha === null;
-  }
-  /**
-   * A run for any task: learner.js's Run for the 1-D LQG (so its numbers do not change) unless the
-   * cfg needs an option only VectorRun has; else a VectorRun.
-   */
-  function makeRun(cfg, task) {
-    if (!task || !task.kind) return new L.Run(cfg, task);
-    if (task.kind === "lqg" && task.dim === 1 && !needsVectorRun(cfg)) return new L.Run(cfg, oneDTask(task));
-    return new VectorRun(cfg, task);
-  }
-  L.Driver.makeRun = makeRun;
+  L.Driver.makeRun = (cfg, task) => new VectorRun(cfg, task);
 
-  Object.assign(L, {VECTOR_DEFAULTS, VectorRun, makeRun, taskConstants, penaltyConstantH, scalarStep,
-                    coordinateStepU, errorBoundN, rngSource, arraySource, oneDTask});
+  Object.assign(L, {runOptions, VectorRun, taskConstants, scalarStep, rngSource, arraySource});
 })(safepgLearner);

@@ -1,0 +1,189 @@
+"""A run's definition as data: one canonical dictionary, and the key that hashes it.
+
+A learning run is decided by its task, its method (the option objects of
+:mod:`safepg.options`), the starting parameters θ₀, the exploration σ and the budget. Each
+of these is a frozen value, and :func:`to_dict` writes any of them as plain JSON data with
+its type named, every field present (defaults included):
+
+>>> to_dict(ErrorModel("bernstein", 0.95, "empirical"))
+{'type': 'ErrorModel', 'bound': 'bernstein', 'delta': 0.95, 'range': 'empirical'}
+
+:func:`from_dict` builds the value again, so ``from_dict(to_dict(x)) == x``. The run key
+(:meth:`safepg.runner.RunConfig.key`), the records' ``config`` and the command line all read
+this one dictionary, under the option objects' own field names.
+
+Tasks enter by their fields: a frozen dataclass task (:class:`~safepg.envs.lqg.LQG`,
+:class:`~safepg.envs.cartpole.CartPole`, or a researcher's own) by its constructor's fields,
+and a task that defines ``definition()`` (:class:`~safepg.envs.gym_task.GymTask`) by the
+keyword arguments that method returns. A function inside a definition (a feature map, an
+environment factory) enters by a name that can be imported again, ``module:qualname``, or by
+the name given for it: a lambda or a nested function without one has no name that would
+change when it changes, and is refused where a definition must be exact (``exact=True``, the
+run keys).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
+
+#: The option objects, by the name their dictionaries carry.
+OPTION_TYPES: dict[str, type] = {cls.__name__: cls for cls in (Adaptive, Vanilla, Gradient, ErrorModel, Batches,
+                                                               Departures, FixedStep, SafeStep, Target)}
+#: The core's tasks, by the short name their dictionaries carry (imported when read).
+TASK_TYPES: dict[str, str] = {"LQG": "safepg.envs.lqg:LQG", "CartPole": "safepg.envs.cartpole:CartPole",
+                              "GymTask": "safepg.envs.gym_task:GymTask"}
+
+
+class UnnamedError(ValueError):
+    """A value of a definition that cannot be written down exactly (a lambda, an unnamed task)."""
+
+
+def function_name(fn: Callable[..., Any]) -> str:
+    """``module:qualname`` of a function that :func:`import_name` finds again.
+
+    Raises
+    ------
+    UnnamedError
+        ``fn`` is a lambda or a function defined inside another (no importable name).
+    """
+    module, qualname = getattr(fn, "__module__", None), getattr(fn, "__qualname__", None)
+    if not module or not qualname or "<" in qualname or module == "__main__":
+        raise UnnamedError(
+            f"{fn!r} has no name a stored run could be found by (a lambda, a nested function or one "
+            f"defined in __main__): define it at the top of an importable module, or give it a name "
+            f"(the task's name= or features_name=) that you change whenever the function changes")
+    return f"{module}:{qualname}"
+
+
+def import_name(name: str) -> Any:
+    """The object ``module:qualname`` names (:func:`function_name`'s inverse)."""
+    module, _, qualname = name.partition(":")
+    if not module or not qualname:
+        raise ValueError(f"name must be 'module:qualname', got {name!r}")
+    obj: Any = importlib.import_module(module)
+    for part in qualname.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+def _type_name(cls: type) -> str:
+    """The name a value's dictionary carries: an option's or a core task's class name, else ``module:qualname``."""
+    full = f"{cls.__module__}:{cls.__qualname__}"
+    if OPTION_TYPES.get(cls.__name__) is cls or TASK_TYPES.get(cls.__name__) == full:
+        return cls.__name__
+    return full
+
+
+def _type_of(name: str) -> type:
+    if name in OPTION_TYPES:
+        return OPTION_TYPES[name]
+    cls = import_name(TASK_TYPES.get(name, name))
+    if not isinstance(cls, type):
+        raise ValueError(f"type must name a class, got {name!r}")
+    return cls
+
+
+def to_dict(value: Any, exact: bool = True) -> Any:
+    """``value`` as canonical JSON data: numbers, strings, lists and dicts.
+
+    A dataclass (an option object, a task) becomes ``{"type": ..., field: value, ...}`` with
+    every constructor field; a value with a ``definition()`` method becomes ``{"type": ...,
+    **definition()}``; arrays and tuples become lists; a function becomes its
+    :func:`function_name`.
+
+    Parameters
+    ----------
+    value
+        What to write.
+    exact
+        Refuse what cannot be written exactly (a lambda, a task that is neither a dataclass
+        nor defines ``definition()``, a NaN). With ``exact=False`` such a value is written as
+        ``{"type": "unnamed", "repr": repr(value)}``, which a record may keep but a key may not.
+
+    Raises
+    ------
+    UnnamedError
+        With ``exact``, a value that cannot be written exactly.
+    """
+    if value is None or isinstance(value, bool | str):
+        return value
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        if math.isnan(value) and exact:
+            raise UnnamedError("a definition cannot hold NaN")
+        return float(value)
+    if isinstance(value, np.ndarray):
+        return to_dict(value.tolist(), exact)
+    if isinstance(value, list | tuple):
+        return [to_dict(v, exact) for v in value]
+    if isinstance(value, Mapping):
+        return {str(k): to_dict(v, exact) for k, v in sorted(value.items())}
+    try:
+        if hasattr(value, "definition") and not isinstance(value, type):
+            fields = value.definition()
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+            fields = {f.name: getattr(value, f.name) for f in dataclasses.fields(value) if f.init}
+        elif callable(value):
+            return function_name(value)
+        else:
+            raise UnnamedError(f"{value!r} is neither a dataclass nor defines definition(): a stored run "
+                               f"cannot name it")
+        return {"type": _type_name(type(value)), **{k: to_dict(v, exact) for k, v in fields.items()}}
+    except UnnamedError:
+        if exact:
+            raise
+        return {"type": "unnamed", "repr": repr(value)}
+
+
+def from_dict(data: Any) -> Any:
+    """The value :func:`to_dict` wrote: ``from_dict(to_dict(x)) == x``.
+
+    Lists come back as tuples inside option objects and tasks (their fields are tuples or
+    scalars); a task's class rebuilds it from its fields, so a class may turn lists back into
+    arrays itself.
+    """
+    if isinstance(data, list):
+        return [from_dict(v) for v in data]
+    if not isinstance(data, dict):
+        return data
+    if "type" not in data:
+        return {k: from_dict(v) for k, v in data.items()}
+    if data["type"] == "unnamed":
+        raise UnnamedError(f"this definition was written without an exact task ({data.get('repr')}): it "
+                           f"cannot be built again")
+    cls = _type_of(data["type"])
+    kwargs = {k: _field_value(v) for k, v in data.items() if k != "type"}
+    rebuild = getattr(cls, "from_definition", None)
+    return rebuild(**kwargs) if rebuild is not None else cls(**kwargs)
+
+
+def _field_value(data: Any) -> Any:
+    value = from_dict(data)
+    return tuple(value) if isinstance(value, list) else value
+
+
+def run_definition(task: Any, method: Adaptive | Vanilla, theta0: Any, sigma: float, budget: int,
+                   stop_on_divergence: bool, warm_start: str | None = None, exact: bool = True) -> dict[str, Any]:
+    """A learning run's whole definition: what a record's ``config`` holds and a run key hashes.
+
+    ``{"task", "method", "theta0", "sigma", "budget", "stop_on_divergence", "warm_start"}``;
+    ``warm_start`` is the key of the run whose final parameters start this one (its
+    ``theta0`` is then None: the start comes from that run).
+    """
+    return {"task": to_dict(task, exact), "method": to_dict(method, exact),
+            "theta0": None if warm_start is not None else to_dict(np.ravel(np.asarray(theta0, dtype=float)), exact),
+            "sigma": to_dict(sigma, exact), "budget": int(budget), "stop_on_divergence": bool(stop_on_divergence),
+            "warm_start": warm_start}
+
+
+__all__ = ["OPTION_TYPES", "TASK_TYPES", "UnnamedError", "from_dict", "function_name", "import_name", "run_definition",
+           "to_dict"]
