@@ -48,12 +48,17 @@ def camel(name: str) -> str:
     return head + "".join(part[:1].upper() + part[1:] for part in rest)
 
 
+def _alternatives(hint: Any) -> tuple[Any, ...]:
+    """The members of a union type hint (``X | None`` gives ``(X, NoneType)``), or the hint alone."""
+    if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
+        return typing.get_args(hint)
+    return (hint,)
+
+
 def _leaf(hint: Any) -> dict[str, Any]:
     """The allowed values of a field's type hint: ``choices``, ``number``, ``integer``, ``nullable``."""
     out: dict[str, Any] = {}
-    args = typing.get_args(hint) if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union \
-        else (hint,)
-    for arg in args:
+    for arg in _alternatives(hint):
         if arg is type(None):
             out["nullable"] = True
         elif arg is bool:
@@ -71,9 +76,7 @@ def _leaf(hint: Any) -> dict[str, Any]:
 
 def _option_types(hint: Any) -> list[str] | None:
     """The option types a field may hold (None when it holds plain values)."""
-    args = typing.get_args(hint) if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union \
-        else (hint,)
-    named = [a.__name__ for a in args if isinstance(a, type) and OPTION_TYPES.get(a.__name__) is a]
+    named = [a.__name__ for a in _alternatives(hint) if isinstance(a, type) and OPTION_TYPES.get(a.__name__) is a]
     return named or None
 
 
@@ -112,7 +115,7 @@ def option_table() -> dict[str, Any]:
             named = _option_types(hint)
             entry: dict[str, Any] = {"field": f.name}
             if named is not None:
-                nullable = type(None) in typing.get_args(hint)
+                nullable = type(None) in _alternatives(hint)
                 entry["types"] = named
                 entry["nested"] = len(named) == 1 and not nullable
                 if nullable:
