@@ -11,8 +11,9 @@
 (function (L) {
   const check = L.check;  // learner.js's: one argument check for every file of the learner
   const O = L.OPTIONS;  // options.js: every option's name, default and allowed values
-  /** The page's own settings beside the run's options: the stream of a seed (its runs draw apart). */
-  const PAGE_FIELDS = Object.freeze({stream: 0});
+  /** The page's own settings beside the run's options, as the table states them: the stream of a seed
+   *  (the runs of one seed draw apart). */
+  const PAGE_FIELDS = Object.freeze({stream: {integer: true, default: 0}});
 
   function allowed(e, v) {
     if (e.types) return e.types.includes(v) || (v === null && !!e.nullable);
@@ -40,10 +41,9 @@
    */
   function runOptions(cfgIn) {
     const given = cfgIn || {};
-    const cfg = {method: given.method === undefined ? "Adaptive" : given.method, ...PAGE_FIELDS};
+    const cfg = {method: given.method === undefined ? "Adaptive" : given.method};
     check(O.methods.includes(cfg.method), `method must be one of ${O.methods.join(", ")}, got ${cfg.method}`);
-    const known = new Set(["method", ...Object.keys(PAGE_FIELDS)]);
-    if ("stream" in given) cfg.stream = given.stream;
+    const known = new Set(["method"]);
     const fill = (name, e) => {
       known.add(name);
       const v = name in given ? given[name] : e.default;
@@ -60,7 +60,7 @@
       }
     };
     visit(cfg.method);
-    for (const [name, e] of Object.entries(O.run)) fill(name, e);
+    for (const [name, e] of Object.entries({...O.run, ...PAGE_FIELDS})) fill(name, e);
     for (const name of Object.keys(given))
       check(known.has(name), `${name} is not an option of this ${cfg.method} run (its options: ${[...known].join(", ")})`);
     return cfg;
