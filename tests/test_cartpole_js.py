@@ -186,6 +186,7 @@ if __name__ == "__main__":  # the cart-pole section of benchmarks/js_learner_agr
     text = table(all_rows)
     print(text)
     write_section("Cart-pole (Section 5.3), doubled pole, from the authors' theta*",
-                  "30 seeds each side, sigma = 1, G(PO)MDP; Welch 99% interval of the difference of means (a "
+                  "30 seeds each side, sigma = 1, G(PO)MDP; Welch 99% interval of the difference of means and the "
+                  "shift it detects with 80% power (a "
                   "frozen theta gives a zero interval and a zero difference). Computed by "
                   "`python tests/test_cartpole_js.py`.\n\n" + text)
