@@ -18,7 +18,8 @@ table number of the thesis is a caption on the page it belongs to
 (:data:`THESIS_CAPTIONS`), while our own figures and tables carry numbers that cannot be
 mistaken for the thesis's. A full-page screenshot of a page at a width and in a theme goes to
 ``_build/screenshots/`` when a check fails there, or of every page with ``SAFEPG_SCREENSHOTS=1``
-(they took more than half of the test's time: 55 of about 100 s).
+(they took more than half of the test's time: 55 of about 100 s). Both page-wide tests read one walk
+over the pages (the ``walk`` fixture): every page is loaded once per width.
 """
 
 from __future__ import annotations
@@ -69,40 +70,34 @@ def toc_pages() -> list[str]:
     return out
 
 
-def test_every_page_loads_offline(browser, book):
-    pages = toc_pages()
-    assert len(pages) >= 2
-    problems: dict[str, Any] = {}
-    for name in pages:
-        path = book / f"{name}.html"
-        assert path.exists(), f"{name} is in _toc.yml but was not built"
-        pg = OfflinePage(browser, path)
-        pg.typeset()
-        info = pg.page.evaluate(r"""() => ({
-            math: document.querySelectorAll('.math').length,
-            untypeset: [...document.querySelectorAll('.math')].filter(e => !e.querySelector('mjx-container'))
-                         .map(e => e.textContent.slice(0, 80)),
-            texErrors: [...document.querySelectorAll('mjx-merror')]
-                         .map(e => e.getAttribute('data-mjx-error') || e.textContent),
-            brokenImages: [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src),
-            explorersNotDrawn: [...document.querySelectorAll('.safepg-explorer')]
-                         .filter(e => !e.querySelector('.safepg-values').textContent).length,
-            // A Markdown table output that was not rendered shows its |---| row as text (after
-            // Sphinx's smart quotes, as an em or en dash).
-            rawMarkdownTables: [...document.querySelectorAll('.cell_output')]
-                         .filter(e => /\|\s*(---|\u2014|\u2013)\s*\|/.test(e.textContent))
-                         .map(e => e.textContent.slice(0, 80)),
-        })""")
-        bad = {k: v for k, v in info.items() if k != "math" and v}
-        errors = [e for e in pg.errors if "favicon" not in e]
-        if errors:
-            bad["console errors"] = errors
-        if pg.remote:
-            bad["requests that left the disk"] = pg.remote
-        if bad:
-            problems[name] = bad
-        pg.page.close()
-    assert not problems, json.dumps(problems, indent=1)
+#: What a page must be once loaded from disk (run on every page at every width of the walk).
+OFFLINE_JS = r"""() => ({
+    math: document.querySelectorAll('.math').length,
+    untypeset: [...document.querySelectorAll('.math')].filter(e => !e.querySelector('mjx-container'))
+                 .map(e => e.textContent.slice(0, 80)),
+    texErrors: [...document.querySelectorAll('mjx-merror')]
+                 .map(e => e.getAttribute('data-mjx-error') || e.textContent),
+    brokenImages: [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src),
+    explorersNotDrawn: [...document.querySelectorAll('.safepg-explorer')]
+                 .filter(e => !e.querySelector('.safepg-values').textContent).length,
+    // A Markdown table output that was not rendered shows its |---| row as text (after
+    // Sphinx's smart quotes, as an em or en dash).
+    rawMarkdownTables: [...document.querySelectorAll('.cell_output')]
+                 .filter(e => /\|\s*(---|\u2014|\u2013)\s*\|/.test(e.textContent))
+                 .map(e => e.textContent.slice(0, 80)),
+})"""
+
+
+def _offline_problems(pg: OfflinePage) -> dict[str, Any]:
+    """A loaded, typeset page's offline problems: untypeset math, TeX errors, broken images, explorers
+    not drawn, raw Markdown tables, console errors and requests that left the disk."""
+    bad = {k: v for k, v in pg.page.evaluate(OFFLINE_JS).items() if k != "math" and v}
+    errors = [e for e in pg.errors if "favicon" not in e]
+    if errors:
+        bad["console errors"] = errors
+    if pg.remote:
+        bad["requests that left the disk"] = pg.remote
+    return bad
 
 
 def _luminance(css: str) -> float:
@@ -280,14 +275,20 @@ def _distorted_images(pg: OfflinePage) -> list[str]:
         .map(({i, w, h}) => `${i.src.split('/').pop()} drawn ${Math.round(w)}x${Math.round(h)}`)""")
 
 
-def test_every_page_reads_well(browser, book):
-    """The page-wide reading checks (see the module docstring), on every page of
-    ``_toc.yml``, at 1280 and 390 px, in the light and the dark theme."""
+@pytest.fixture(scope="module")
+def walk(browser: Any, book: Path) -> dict[str, Any]:
+    """Every page of ``_toc.yml`` opened once at each width (1280 and 390 px), where each load is
+    checked offline (:func:`_offline_problems`) and read in the light and the dark theme; the
+    findings by check, for the tests below. One walk for both: each page load costs about 2 s."""
+    offline: dict[str, Any] = {}
     problems: dict[str, Any] = {}
     captions_by_page: dict[str, list[str]] = {}
     SHOTS.mkdir(parents=True, exist_ok=True)
-    for name in toc_pages():
+    pages = toc_pages()
+    assert len(pages) >= 9
+    for name in pages:
         path = book / f"{name}.html"
+        assert path.exists(), f"{name} is in _toc.yml but was not built"
         for width in WIDTHS:
             pg = OfflinePage(browser, path, width=width, height=900)
             pg.typeset()
@@ -329,8 +330,23 @@ def test_every_page_reads_well(browser, book):
                 if bad or os.environ.get("SAFEPG_SCREENSHOTS") == "1":
                     pg.page.screenshot(path=str(SHOTS / f"{name.split('/')[-1]}-{width}-{theme}.png"),
                                        full_page=True)
-            assert not pg.errors, (name, pg.errors)
+            off = _offline_problems(pg)  # after both themes: errors and requests of the load and the switches
+            if off:
+                offline[f"{name} @{width}px"] = off
             pg.page.close()
+    return {"offline": offline, "reading": problems, "captions": captions_by_page}
+
+
+def test_every_page_loads_offline(walk):
+    """Every page, at both widths, from disk: no console error, no request leaving the disk, every
+    formula typeset, every image decoded, every explorer drawn, no raw Markdown table."""
+    assert not walk["offline"], json.dumps(walk["offline"], indent=1, ensure_ascii=False)
+
+
+def test_every_page_reads_well(walk):
+    """The page-wide reading checks (see the module docstring), on every page of
+    ``_toc.yml``, at 1280 and 390 px, in the light and the dark theme."""
+    problems, captions_by_page = dict(walk["reading"]), walk["captions"]
     # every thesis number on its page, once; every other number visibly ours
     thesis_numbers = {n for numbers in THESIS_CAPTIONS.values() for n in numbers}
     for name, captions in captions_by_page.items():
