@@ -1,10 +1,15 @@
-"""The page object both browser test files drive (fixtures are in tests/conftest.py)."""
+"""The page object the browser test files drive, and the pages they walk (fixtures are in tests/conftest.py)."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 class OfflinePage:
@@ -131,3 +136,22 @@ AUDIT_JS = r"""() => {
   return {pageOverflow: Math.max(0, de.scrollWidth - de.clientWidth), column: [Math.round(A.left), Math.round(A.right)],
           overflowing, clipped, scrollNoCue, code, captions};
 }"""
+
+
+def toc_pages() -> list[str]:
+    """Document names in ``_toc.yml`` (root first), e.g. ``book/intro``."""
+    toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
+    out = [toc["root"]]
+
+    def walk(node: Any) -> None:
+        if isinstance(node, dict):
+            if "file" in node:
+                out.append(re.sub(r"\.(md|ipynb)$", "", node["file"]))
+            for v in node.values():
+                walk(v)
+        elif isinstance(node, list):
+            for v in node:
+                walk(v)
+
+    walk({k: v for k, v in toc.items() if k != "root"})
+    return out

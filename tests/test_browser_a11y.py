@@ -2,7 +2,9 @@
 
 axe-core (pinned in ``book/tools/vendor_assets.sh``, fetched from the npm registry into
 ``_build/vendor/axe-core``) runs on every page of ``_toc.yml`` at 1280 px, in the light and
-the dark theme of pydata-sphinx-theme (switched as its toggle does, ``OfflinePage.set_theme``).
+the dark theme of pydata-sphinx-theme (switched as its toggle does, ``OfflinePage.set_theme``),
+during the walk over the pages of ``tests/test_browser_book.py`` (``test_every_page_passes_axe``
+there), which loads each page once for all its page-wide checks; this module holds the audit.
 Any violation of impact "serious" or "critical" fails the test, printed as page, theme,
 rule id, impact, the target selectors and axe's one-line help. The checker itself is
 checked: on a probe page an unlabelled slider, checkbox and select must be reported, while
@@ -31,8 +33,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from browser_pages import OfflinePage
-from test_browser_book import toc_pages
+from browser_pages import OfflinePage, toc_pages
 
 ROOT = Path(__file__).resolve().parents[1]
 AXE_DIR = ROOT / "_build" / "vendor" / "axe-core"
@@ -94,25 +95,6 @@ def report(where: str, violations: list[dict[str, Any]]) -> list[str]:
         targets = "; ".join(n["target"] for n in v["nodes"][:6]) + (" ..." if len(v["nodes"]) > 6 else "")
         lines.append(f"{where}: {v['id']} ({v['impact']}) x{len(v['nodes'])} at {targets} -- {v['help']}")
     return lines
-
-
-def test_every_page_passes_axe(browser, book, axe_js):
-    problems: list[str] = []
-    pages = toc_pages()
-    assert len(pages) >= 9
-    for name in pages:
-        path = book / f"{name}.html"
-        assert path.exists(), f"{name} is in _toc.yml but was not built"
-        pg = OfflinePage(browser, path, width=1280, height=900)
-        pg.typeset()
-        pg.page.wait_for_function("() => document.readyState === 'complete'")
-        for theme in ("light", "dark"):
-            pg.set_theme(theme)
-            assert pg.page.evaluate("() => document.documentElement.dataset.theme") == theme
-            problems += report(f"{name} [{theme}]", serious_violations(pg, axe_js))
-        assert not pg.errors, (name, pg.errors)
-        pg.page.close()
-    assert not problems, "axe-core: serious or critical violations\n" + "\n".join(problems)
 
 
 def _probe_explorer_html() -> str:

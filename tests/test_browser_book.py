@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-import yaml
-from browser_pages import OfflinePage
+from browser_pages import OfflinePage, toc_pages
+from test_browser_a11y import load_axe, report, serious_violations
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
@@ -49,25 +49,6 @@ def lqg_performance(theta: float | np.ndarray, sigma: float, gamma: float = 0.9,
     theta = np.asarray(theta, dtype=float)
     P = 0.5 * (1 + theta**2) / (1 - gamma * (1 + theta) ** 2)
     return -(b**2 / 3) * P - sigma**2 * (0.5 + gamma * P) / (1 - gamma)
-
-
-def toc_pages() -> list[str]:
-    """Document names in ``_toc.yml`` (root first), e.g. ``book/intro``."""
-    toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
-    out = [toc["root"]]
-
-    def walk(node: Any) -> None:
-        if isinstance(node, dict):
-            if "file" in node:
-                out.append(re.sub(r"\.(md|ipynb)$", "", node["file"]))
-            for v in node.values():
-                walk(v)
-        elif isinstance(node, list):
-            for v in node:
-                walk(v)
-
-    walk({k: v for k, v in toc.items() if k != "root"})
-    return out
 
 
 #: What a page must be once loaded from disk (run on every page at every width of the walk).
@@ -278,8 +259,11 @@ def _distorted_images(pg: OfflinePage) -> list[str]:
 @pytest.fixture(scope="module")
 def walk(browser: Any, book: Path) -> dict[str, Any]:
     """Every page of ``_toc.yml`` opened once at each width (1280 and 390 px), where each load is
-    checked offline (:func:`_offline_problems`) and read in the light and the dark theme; the
-    findings by check, for the tests below. One walk for both: each page load costs about 2 s."""
+    read in the light and the dark theme, audited by axe-core at 1280 px in both themes
+    (``tests/test_browser_a11y.py``), and checked offline (:func:`_offline_problems`); the
+    findings by check, for the tests below. One walk for the three: each page load costs about 2 s."""
+    axe_js = load_axe()
+    axe: list[str] = []
     offline: dict[str, Any] = {}
     problems: dict[str, Any] = {}
     captions_by_page: dict[str, list[str]] = {}
@@ -330,11 +314,20 @@ def walk(browser: Any, book: Path) -> dict[str, Any]:
                 if bad or os.environ.get("SAFEPG_SCREENSHOTS") == "1":
                     pg.page.screenshot(path=str(SHOTS / f"{name.split('/')[-1]}-{width}-{theme}.png"),
                                        full_page=True)
+                if width == WIDTHS[0]:
+                    assert pg.page.evaluate("() => document.documentElement.dataset.theme") == theme
+                    axe += report(f"{name} [{theme}]", serious_violations(pg, axe_js))
             off = _offline_problems(pg)  # after both themes: errors and requests of the load and the switches
             if off:
                 offline[f"{name} @{width}px"] = off
             pg.page.close()
-    return {"offline": offline, "reading": problems, "captions": captions_by_page}
+    return {"offline": offline, "reading": problems, "captions": captions_by_page, "axe": axe}
+
+
+def test_every_page_passes_axe(walk):
+    """axe-core on every page at 1280 px, light and dark: no serious or critical violation
+    (``tests/test_browser_a11y.py`` says what the audit runs and checks that it can fail)."""
+    assert not walk["axe"], "axe-core: serious or critical violations\n" + "\n".join(walk["axe"])
 
 
 def test_every_page_loads_offline(walk):
