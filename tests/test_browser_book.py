@@ -18,8 +18,9 @@ table number of the thesis is a caption on the page it belongs to
 (:data:`THESIS_CAPTIONS`), while our own figures and tables carry numbers that cannot be
 mistaken for the thesis's. A full-page screenshot of a page at a width and in a theme goes to
 ``_build/screenshots/`` when a check fails there, or of every page with ``SAFEPG_SCREENSHOTS=1``
-(they took more than half of the test's time: 55 of about 100 s). Both page-wide tests read one walk
-over the pages (the ``walk`` fixture): every page is loaded once per width.
+(they took more than half of the test's time: 55 of about 100 s). The page-wide tests, these two
+and axe-core's audit (``test_every_page_passes_axe``), read one walk over the pages (the ``walk``
+fixture): every page is loaded once per width.
 """
 
 from __future__ import annotations
