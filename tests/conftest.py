@@ -100,6 +100,14 @@ def book(request, tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def axe_js() -> str:
+    """axe-core's source, for every test that audits a page (``tests/test_browser_a11y.py``'s ``load_axe``)."""
+    from test_browser_a11y import load_axe
+
+    return load_axe()
+
+
+@pytest.fixture(scope="session")
 def browser() -> Iterator[Any]:
     """Debian's Chromium, headless, driven by Playwright (a ``Browser``)."""
     if not Path(CHROMIUM).exists():

@@ -65,11 +65,6 @@ def load_axe() -> str:
     return (AXE_DIR / "axe.min.js").read_text(encoding="utf-8")
 
 
-@pytest.fixture(scope="session")
-def axe_js() -> str:
-    return load_axe()
-
-
 def excluded(rule: str, target: str) -> bool:
     return any(rule == r and re.search(sel, target) for r, sel, _ in EXCLUSIONS)
 

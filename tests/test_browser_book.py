@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import pytest
 from browser_pages import OfflinePage, toc_pages
-from test_browser_a11y import load_axe, report, serious_violations
+from test_browser_a11y import report, serious_violations
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
@@ -258,12 +258,11 @@ def _distorted_images(pg: OfflinePage) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def walk(browser: Any, book: Path) -> dict[str, Any]:
+def walk(browser: Any, book: Path, axe_js: str) -> dict[str, Any]:
     """Every page of ``_toc.yml`` opened once at each width (1280 and 390 px), where each load is
     read in the light and the dark theme, audited by axe-core at 1280 px in both themes
     (``tests/test_browser_a11y.py``), and checked offline (:func:`_offline_problems`); the
     findings by check, for the tests below. One walk for the three: each page load costs about 2 s."""
-    axe_js = load_axe()
     axe: list[str] = []
     offline: dict[str, Any] = {}
     problems: dict[str, Any] = {}

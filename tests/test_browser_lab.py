@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from test_browser_a11y import FAILING, load_axe, report
+from test_browser_a11y import FAILING, report
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
@@ -454,11 +454,6 @@ NAMES = """(el, excluded) => { axe.setup(document); try {
                axe.commons.text.accessibleTextVirtual(axe.utils.getNodeFromTree(c)).trim(),
                !!(excluded && c.matches(excluded))]);
 } finally { axe.teardown(); } }"""
-
-
-@pytest.fixture(scope="module")
-def axe_js() -> str:
-    return load_axe()
 
 
 #: Violations inside the views that we cannot fix from our files, ``(rule, CSS selector of the

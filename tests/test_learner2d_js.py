@@ -151,11 +151,13 @@ def welch_rows(label: str, values: dict[str, tuple[np.ndarray, np.ndarray]]) -> 
     return rows
 
 
-def table(rows: list[dict[str, Any]]) -> str:
+def table(rows: list[dict[str, Any]], setting: tuple[str, ...] = ("setting",)) -> str:
+    """The rows as a Markdown table; ``setting`` names the columns that each row's ``setting`` fills
+    (cells of its text separated by " | ")."""
     n = rows[0]["seeds"]
-    lines = [f"| setting | metric | JS ({n} seeds) | safepg ({n} seeds) | difference | 99% CI half-width | inside "
-             "| shift detected with 80% power |",
-             "|---|---|---|---|---|---|---|---|"]
+    head = [*setting, "metric", f"JS ({n} seeds)", f"safepg ({n} seeds)", "difference", "99% CI half-width",
+            "inside", "shift detected with 80% power"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += [f"| {r['setting']} | {r['metric']} | {r['js']:.6g} | {r['py']:.6g} | {r['diff']:+.3g} | "
               f"{r['half_ci99']:.3g} | {'yes' if r['inside'] else 'NO'} | {r['detect80']:.3g} |" for r in rows]
     return "\n".join(lines)

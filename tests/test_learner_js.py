@@ -465,7 +465,7 @@ if __name__ == "__main__":  # the 1-D part of benchmarks/js_learner_agreement.md
 
     t0 = cpu_s()
     rows = [r for b, er, est, s in STAT_CONFIGS for r in agreement(b, er, est, s)]
-    text = table(rows).replace("| setting |", "| bound | estimator | sigma |", 1).replace("|---|", "|---|---|---|", 1)
+    text = table(rows, setting=("bound", "estimator", "sigma"))
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                             check=False).stdout.strip()
     head = (f"Statistical agreement of the page's JavaScript learner with safepg on the 1-D LQG: {SEEDS} seeds each, "
