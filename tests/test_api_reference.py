@@ -197,3 +197,23 @@ def test_every_parameter_name_is_a_name(built_page: str) -> None:
     # A name, or names joined by commas ("progress, desc"); never words separated by spaces.
     sentences = [n for n in names if any(" " in part.strip() for part in n.split(","))]
     assert not sentences, f"text read as parameter names (a paragraph after a Parameters list?): {sentences}"
+
+
+def test_documented_names_are_computed_once_per_writing_phase(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every missing reference of a build reads the same map; a new read of the pages renews it."""
+    calls: list[object] = []
+
+    def documented_now(env: object) -> dict[int, str]:
+        calls.append(env)
+        return {len(calls): "safepg.name"}
+
+    class Environment:  # a stand-in for Sphinx's: only its identity matters
+        pass
+
+    monkeypatch.setattr(listing, "_documented_now", documented_now)
+    env, other = Environment(), Environment()
+    first = listing._documented(env)
+    assert listing._documented(env) is first and calls == [env]
+    assert listing._documented(other) == {2: "safepg.name"}
+    listing._forget(None, env)
+    assert listing._documented(env) == {3: "safepg.name"} and calls == [env, other, env]
