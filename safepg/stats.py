@@ -118,7 +118,9 @@ def prediction_band95(values: np.ndarray, runs: int = 1) -> tuple[np.ndarray, np
         for row, ok in zip(filled, present):
             squares = squares + np.where(ok, (row - mean) ** 2, 0.0)
         sd = np.sqrt(squares / (k - 1))
-    t = np.array([t_quantile_975(int(n) - 1) if n > 1 else np.nan for n in k])
+    # One quantile per distinct seed count, not per point: a curve has thousands of points.
+    counts, where = np.unique(k, return_inverse=True)
+    t = np.array([t_quantile_975(int(n) - 1) if n > 1 else np.nan for n in counts])[where.reshape(k.shape)]
     half = np.where(k > 1, t * sd * np.sqrt(1 / runs + 1 / np.maximum(k, 1)), np.nan)
     return mean, half, k
 

@@ -200,6 +200,25 @@ def test_clopper_pearson_upper_is_scipy_beta_quantile(n):
     assert safety.clopper_pearson_upper(1, n, "0.99") == pytest.approx(expected, abs=1e-10)
 
 
+@pytest.mark.parametrize("level", ["0.95", "0.99"])
+def test_clopper_pearson_upper_stops_its_bisection_without_changing_a_bit(level):
+    """The bisection ends once both ends round to one float: the bound is the float of the full
+    120 halvings, bit for bit (a stored measurement's bound must not move)."""
+    import mpmath
+
+    def full_bisection(k, n):
+        with mpmath.workdps(40):
+            lo, hi = mpmath.mpf(0), mpmath.mpf(1)
+            for _ in range(120):
+                mid = (lo + hi) / 2
+                lo, hi = (mid, hi) if safety._binomial_cdf(k, n, mid) > 1 - mpmath.mpf(level) else (lo, mid)
+            return float(hi)
+
+    for n in (2, 3, 17, 97, 401):
+        for k in sorted({1, n // 3, n // 2, n - 1}):
+            assert safety.clopper_pearson_upper(k, n, level) == full_bisection(k, n), (k, n)
+
+
 def test_clopper_pearson_upper_values_and_refusals():
     assert safety.clopper_pearson_upper(0, 16) == pytest.approx(0.1707497, abs=1e-7)  # 0 of 16: still 17%
     assert safety.clopper_pearson_upper(7, 7) == 1.0

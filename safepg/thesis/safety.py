@@ -93,7 +93,8 @@ def clopper_pearson_upper(k: int, n: int, level: str = "0.95") -> float:
     share, the bound lies above it with probability at least ``level``.
 
     Computed with mpmath (software arithmetic, 40 digits: the binomial sum :math:`P(X \le k)`
-    and a bisection of fixed length on it), so the same to the last bit on every CPU.
+    and a bisection on it, to 2^-120 or until both ends round to one float), so the same to
+    the last bit on every CPU.
 
     Parameters
     ----------
@@ -120,6 +121,9 @@ def clopper_pearson_upper(k: int, n: int, level: str = "0.95") -> float:
             return float(1 - mpmath.power(1 - q, mpmath.mpf(1) / n))
         lo, hi = mpmath.mpf(0), mpmath.mpf(1)
         for _ in range(120):  # P(X <= k) falls as p grows: halve [lo, hi] to 2^-120
+            if float(lo) == float(hi):
+                # Rounding is monotone: every later hi, inside [lo, hi], rounds to this float too.
+                break
             mid = (lo + hi) / 2
             if _binomial_cdf(k, n, mid) > 1 - q:
                 lo = mid
