@@ -30,9 +30,10 @@ setup:
 # ruff, ziglang, build, ...), on top of setup's venv, by setup's uv; installed again when that file or
 # setup's own install changes.
 setup-dev: setup
-	@h=$$(cat requirements-dev.txt .venv/.safepg-setup | sha256sum | cut -d' ' -f1); \
+	@h=$$(cat requirements-dev.txt requirements-excludes.txt .venv/.safepg-setup | sha256sum | cut -d' ' -f1); \
 	if [ "$$(cat .venv/.safepg-dev 2>/dev/null)" != "$$h" ]; then \
-	  UV_PYTHON_DOWNLOADS=never $(VBIN)/uv pip install --quiet --python $(VPY) -r requirements-dev.txt \
+	  UV_PYTHON_DOWNLOADS=never $(VBIN)/uv pip install --quiet --python $(VPY) --excludes requirements-excludes.txt \
+	    -r requirements-dev.txt \
 	  && echo "$$h" > .venv/.safepg-dev \
 	  && echo "setup-dev: installed requirements-dev.txt into .venv"; fi
 

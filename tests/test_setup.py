@@ -159,6 +159,10 @@ def test_make_setup_on_stock_debian_python(debian_clones):
         assert "home = /usr/bin\n" in cfg and "include-system-site-packages = false" in cfg
         # From outside the clone, so that nothing is imported from the working directory.
         assert imported_safepg(clone.python, debian_clones["tmp"]) == str(clone.path / "safepg" / "__init__.py")
+        # requirements-excludes.txt: JupyterLab's dependencies ask for it, the venv does without it.
+        excluded = subprocess.run([str(clone.python), "-c", "import jsonschema, nbformat; import rfc3987_syntax"],
+                                  env=user_env(), capture_output=True, text=True)
+        assert "No module named 'rfc3987_syntax'" in excluded.stderr, excluded.stderr
         git_status = subprocess.run(["git", "-C", str(clone.path), "status", "--porcelain"], capture_output=True,
                                     text=True, check=True).stdout
         assert git_status == ""  # everything setup made is git-ignored
@@ -234,7 +238,7 @@ def test_two_clones_each_kernel_imports_its_own_safepg(debian_clones):
 def _script_copy(tmp_path: Path) -> tuple[Path, dict[str, str], Path]:
     """tools/setup_venv.sh in an empty clone-like folder, an interpreter without ensurepip, a stand-in apt-get."""
     (tmp_path / "tools").mkdir()
-    for name in ("tools/setup_venv.sh", "requirements.txt", "pyproject.toml"):
+    for name in ("tools/setup_venv.sh", "requirements.txt", "requirements-excludes.txt", "pyproject.toml"):
         (tmp_path / name).write_bytes((ROOT / name).read_bytes())
     fake = tmp_path / "fake"
     fake.mkdir()

@@ -68,11 +68,12 @@ fi
 # venv's interpreter, never one of its own (UV_PYTHON_DOWNLOADS=never, --python).
 UV_PIN=uv==0.13.9
 export UV_PYTHON_DOWNLOADS=never
-uv_install() { "$venv/bin/uv" pip install --quiet --python "$vpy" "$@"; }
+# requirements-excludes.txt: what is never installed, even as a dependency (the file says why).
+uv_install() { "$venv/bin/uv" pip install --quiet --python "$vpy" --excludes requirements-excludes.txt "$@"; }
 
-# What the install depends on: the pins, the package's metadata (its version is read from
+# What the install depends on: the pins and exclusions, the package's metadata (its version is read from
 # safepg/__init__.py), the installer and the venv's interpreter.
-inputs=$( { cat requirements.txt pyproject.toml; grep '^__version__' safepg/__init__.py 2>/dev/null || true; \
+inputs=$( { cat requirements.txt requirements-excludes.txt pyproject.toml; grep '^__version__' safepg/__init__.py 2>/dev/null || true; \
             echo "$UV_PIN"; base_of "$vpy"; } | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$inputs" ]; then
   rm -f "$stamp"  # an interrupted install is redone next time
@@ -80,6 +81,8 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$inputs" ]; then
   "$vpy" -m pip install --quiet --disable-pip-version-check "$UV_PIN"
   uv_install -r requirements.txt
   uv_install --no-deps -e .
+  # A venv made before a package was excluded still holds it.
+  "$venv/bin/uv" pip uninstall --quiet --python "$vpy" -r requirements-excludes.txt
   # The notebooks' kernel "python3", inside the venv (never --user: that one would be every
   # clone's). Jupyter run from the venv, or with the JUPYTER_PATH the Makefile sets, finds it
   # before any kernel of that name in ~/.local/share/jupyter.
