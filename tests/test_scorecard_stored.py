@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -98,3 +99,20 @@ def test_scorecard_is_the_same_stored_or_not(tmp_path, monkeypatch):
     assert scorecard(root=tmp_path, store=False) == first and len(calls) == 2
     assert [r.id for r in scorecard(root=tmp_path, pages=["lqg2d"])] == [r.id for r in first
                                                                         if r.link.startswith("lqg2d.html")]
+
+
+def test_a_theory_page_reads_the_stored_rows_and_else_derives_only_its_closed_forms(tmp_path, monkeypatch):
+    """A chapter without runs takes its rows from the build's stored scorecard when there is one
+    (the same rows: test_rows_of_some_pages_equal_the_full_cards_rows), else derives its closed
+    forms alone; it never builds the whole card."""
+    derived = []
+    closed_forms = rows_module.closed_form_rows
+    monkeypatch.setattr(rows_module, "closed_form_rows", lambda b: derived.append(1) or closed_forms(b))
+    monkeypatch.setattr(rows_module, "_build", lambda *a, **k: pytest.fail("a theory page built the whole card"))
+    alone = scorecard(root=tmp_path, pages=["errata"])
+    assert alone and len(derived) == 1 and not (tmp_path / stored.FOLDER).exists()
+
+    marked = [replace(r, explanation="read from the stored card") for r in alone]
+    stored.stored_rows(tmp_path, rows_module.BOOK, lambda: marked)
+    assert scorecard(root=tmp_path, pages=["errata"]) == marked and len(derived) == 1
+    assert scorecard(root=tmp_path, pages=["errata"], store=False) == alone and len(derived) == 2

@@ -47,16 +47,25 @@ def inputs_key(root: Path, book: Path) -> str:
     return h.hexdigest()
 
 
+def rows_if_stored(root: Path, book: Path) -> list[Row] | None:
+    """The rows stored for the present inputs, or None when there are none (nothing is built)."""
+    path = root / FOLDER / f"{inputs_key(root, book)}.json"
+    if not path.is_file():
+        return None
+    return [Row.from_dict(d) for d in json.loads(path.read_text(encoding="utf-8"))]
+
+
 def stored_rows(root: Path, book: Path, build: Callable[[], list[Row]]) -> list[Row]:
     """The rows stored for the present inputs, or ``build()``'s, stored for the next reader.
 
     The file is written atomically (a temporary file renamed), so a reader in another process
     sees either no file or a whole one; files of earlier states are removed.
     """
+    rows = rows_if_stored(root, book)
+    if rows is not None:
+        return rows
     folder = root / FOLDER
     path = folder / f"{inputs_key(root, book)}.json"
-    if path.is_file():
-        return [Row.from_dict(d) for d in json.loads(path.read_text(encoding="utf-8"))]
     rows = build()
     folder.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
