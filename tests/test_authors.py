@@ -68,6 +68,20 @@ def test_runs_are_what_the_manifest_says() -> None:
     assert len(curves) == 12 and all(c["J"][0] == -56.666667 for c in curves.values())
 
 
+def test_each_runs_rows_are_its_source_rows_in_file_order() -> None:
+    """The one-pass split by source gives each run the rows a mask on its source number selects."""
+    files = [name for name, entry in A.manifest()["files"].items() if "source" in A._read(name)[0]]
+    assert len(files) >= 5
+    for name in files:
+        header, table = A._read(name)
+        which = table[:, header.index("source")].astype(int)
+        sources = len(A.manifest()["files"][name]["sources"])
+        for n in (sources, sources - 1):  # a source number beyond the manifest's is dropped
+            parts = A._rows_by_source(name, n)
+            assert len(parts) == n and all(np.array_equal(p, table[which == i]) for i, p in enumerate(parts)), name
+            assert not any(p.flags.writeable for p in parts), "shared between lookups: read-only"
+
+
 # ------------------------------------------------------------------ the rules
 def test_rules_on_small_examples() -> None:
     assert A.strict_improvement_ratio([1.0, 2.0, 2.0, 1.0, 3.0]) == 0.5  # a tie is no increase

@@ -142,7 +142,8 @@ def _rows_by_source(name: str, sources: int) -> tuple[np.ndarray, ...]:
     header, table = _read(name)
     which = table[:, header.index("source")].astype(int)
     order = np.argsort(which, kind="stable")
-    parts = np.split(table[order], np.searchsorted(which[order], np.arange(1, sources)))
+    # Rows of a source number beyond the manifest's fall into a last part, which is dropped.
+    parts = np.split(table[order], np.searchsorted(which[order], np.arange(1, sources + 1)))[:sources]
     for part in parts:
         part.setflags(write=False)
     return tuple(parts)
