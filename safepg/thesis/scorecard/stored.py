@@ -47,12 +47,15 @@ def inputs_key(root: Path, book: Path) -> str:
     return h.hexdigest()
 
 
-def rows_if_stored(root: Path, book: Path) -> list[Row] | None:
-    """The rows stored for the present inputs, or None when there are none (nothing is built)."""
-    path = root / FOLDER / f"{inputs_key(root, book)}.json"
+def _read(path: Path) -> list[Row] | None:
     if not path.is_file():
         return None
     return [Row.from_dict(d) for d in json.loads(path.read_text(encoding="utf-8"))]
+
+
+def rows_if_stored(root: Path, book: Path) -> list[Row] | None:
+    """The rows stored for the present inputs, or None when there are none (nothing is built)."""
+    return _read(root / FOLDER / f"{inputs_key(root, book)}.json")
 
 
 def stored_rows(root: Path, book: Path, build: Callable[[], list[Row]]) -> list[Row]:
@@ -61,11 +64,11 @@ def stored_rows(root: Path, book: Path, build: Callable[[], list[Row]]) -> list[
     The file is written atomically (a temporary file renamed), so a reader in another process
     sees either no file or a whole one; files of earlier states are removed.
     """
-    rows = rows_if_stored(root, book)
+    folder = root / FOLDER
+    path = folder / f"{inputs_key(root, book)}.json"  # the key hashes every input: once per call
+    rows = _read(path)
     if rows is not None:
         return rows
-    folder = root / FOLDER
-    path = folder / f"{inputs_key(root, book)}.json"
     rows = build()
     folder.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
