@@ -6,6 +6,7 @@ inheriting it:
 
 * :class:`GradientBatch`: a batch's gradient samples and returns in one fused call;
 * :class:`GradientBatchConstants`: the same and the batch's measured R and M_phi;
+* :class:`FixedStepBatches`: whole runs of vanilla policy gradient with a fixed step;
 * :class:`MeasuredReturns`: the per-trajectory performance the loops record as J_hat;
 * :class:`Performance` / :class:`PerformanceBatch`: the closed-form J;
 * :class:`ActionDimension`: the number of action dimensions (else 1).
@@ -65,6 +66,18 @@ class GradientBatchConstants(Protocol):
         ...
 
 
+class FixedStepBatches(Protocol):
+    """Consecutive batches of vanilla policy gradient with a fixed step, in one call."""
+
+    def fixed_step_batches(self, policy: LinearGaussianPolicy, sizes: np.ndarray, keys: np.ndarray, alpha: float,
+                           kind: str = "scalar", estimator: str = "gpomdp", baseline: bool = True,
+                           score_action: str = "clipped") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Parameters (b + 1, m), gradients (b, m) and mean measured returns (b,) of batches of
+        ``sizes[i]`` trajectories drawn with ``keys[i]``: the numbers of ``gradient_batch`` and of
+        the step, batch after batch, up to the first non-finite gradient or parameters."""
+        ...
+
+
 class MeasuredReturns(Protocol):
     """The per-trajectory performance recorded as J_hat (default: the discounted return)."""
 
@@ -91,7 +104,8 @@ class PerformanceBatch(Protocol):
 
 #: The optional methods, by the Protocol that declares each.
 METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
-                                 MeasuredReturns: "measured_returns", Performance: "performance",
+                                 FixedStepBatches: "fixed_step_batches", MeasuredReturns: "measured_returns",
+                                 Performance: "performance",
                                  PerformanceBatch: "performance_batch"}
 
 
@@ -101,6 +115,7 @@ class Hooks:
 
     gradient_batch: Callable[..., tuple[np.ndarray, np.ndarray]] | None
     gradient_batch_constants: Callable[..., tuple[np.ndarray, np.ndarray, tuple[float, float]]] | None
+    fixed_step_batches: Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]] | None
     measured_returns: Callable[[Trajectories], np.ndarray] | None
     performance: Callable[[Any, Any], float] | None
     performance_batch: Callable[[np.ndarray, Any], np.ndarray] | None
@@ -159,5 +174,5 @@ def task_hooks(task: Task) -> Hooks:
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
 
 
-__all__ = ["METHOD_HOOKS", "ActionDimension", "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns",
-           "Performance", "PerformanceBatch", "Task", "task_hooks"]
+__all__ = ["METHOD_HOOKS", "ActionDimension", "FixedStepBatches", "GradientBatch", "GradientBatchConstants", "Hooks",
+           "MeasuredReturns", "Performance", "PerformanceBatch", "Task", "task_hooks"]

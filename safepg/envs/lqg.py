@@ -28,7 +28,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, GradientBatch, Performance, PerformanceBatch
+from safepg.tasks import ActionDimension, FixedStepBatches, GradientBatch, Performance, PerformanceBatch
 from safepg.trajectories import Trajectories
 
 
@@ -50,7 +50,7 @@ def _largest_eigenvalue(M: np.ndarray) -> float:
 
 
 @dataclass(frozen=True)
-class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
+class LQG(GradientBatch, FixedStepBatches, Performance, PerformanceBatch, ActionDimension):
     """LQG regulation task with box-bounded states and actions.
 
     Parameters
@@ -375,6 +375,59 @@ class LQG(GradientBatch, Performance, PerformanceBatch, ActionDimension):
         else:
             kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
         out = kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        return out
+
+    def fixed_step_batches(
+        self,
+        policy: LinearGaussianPolicy,
+        sizes: np.ndarray,
+        keys: np.ndarray,
+        alpha: float,
+        kind: str = "scalar",
+        estimator: str = "gpomdp",
+        baseline: bool = True,
+        score_action: str = "clipped",
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r"""Consecutive batches of vanilla policy gradient with a fixed step, in one compiled loop.
+
+        Batch i draws ``sizes[i]`` trajectories with batch key ``keys[i]`` (the numbers
+        :meth:`gradient_batch` draws with that key), and
+        :math:`\theta_{i+1} = \theta_i + \alpha\hat\nabla J` (``kind="scalar"``) or only the
+        first largest component moves (``"coordinate"``), in the order and with the bits of
+        :func:`safepg.learning.vanilla_pg`'s loop (see :mod:`!safepg.envs._lqg_fixed_step`).
+
+        Returns
+        -------
+        thetas : ndarray, shape (b + 1, m)
+            The parameters before each batch, then the last ones; b rows only when the last
+            gradient is not finite (no step was taken).
+        grads : ndarray, shape (b, m)
+            Each batch's gradient estimate.
+        j_hat : ndarray, shape (b,)
+            Each batch's mean discounted return.
+
+        The loop stops after the first batch whose gradient, or whose new parameters, are not
+        finite (b < ``len(keys)``); the caller decides what that means.
+        """
+        from safepg.envs._lqg_fixed_step import FIXED_STEP_BATCHES
+
+        self._check_policy(policy)
+        sizes = np.asarray(sizes, dtype=np.int64)
+        keys = np.asarray(keys, dtype=np.uint64)
+        if sizes.ndim != 1 or keys.shape != sizes.shape:
+            raise ValueError(f"keys must have the shape of sizes {sizes.shape}, got {keys.shape}")
+        if sizes.size and sizes.min() < 1:
+            raise ValueError(f"sizes must be positive integers, got {sizes.min()}")
+        if kind not in ("scalar", "coordinate"):
+            raise ValueError(f"kind must be 'scalar' or 'coordinate', got {kind!r}")
+        check_estimator(estimator)
+        check_score_action(score_action)
+        A, B, Q, R = self._mats
+        loop = FIXED_STEP_BATCHES.get(self.dim, FIXED_STEP_BATCHES[0])
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] = loop(
+            policy.gain.ravel().copy(), policy.cov_chol, policy.precision, A, B, Q, R, keys, sizes,
+            int(self.horizon), float(self.gamma), float(self.state_bound), float(self.action_bound), bool(self.clip),
+            score_action == "clipped", estimator == "reinforce", bool(baseline), float(alpha), kind == "coordinate")
         return out
 
 

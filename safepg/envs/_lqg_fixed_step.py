@@ -1,0 +1,220 @@
+"""Consecutive batches of vanilla policy gradient with a fixed step on the LQG, in one compiled call.
+
+A run of vanilla G(PO)MDP with a small batch is mostly loop overhead when each batch is a Python
+iteration: Table 5.3's N = 100 runs have 3*10^5 of them, and the step itself is one
+multiply-add per component. Here the loop runs in numba around the fused serial kernels of
+:mod:`!safepg.envs._lqg_kernel`, and does each Python step in NumPy's own order, so a run
+gives the bits of :func:`safepg.learning.vanilla_pg`'s loop (tested):
+
+* the gradient estimate ``samples.sum(axis=0) / n``: NumPy sums a column vector (m = 1) by
+  its pairwise summation (:func:`pairwise_sum`), and the columns of an (n, m >= 2) array
+  row after row into zeros;
+* the batch's mean return ``returns.sum() / n``, pairwise;
+* the step ``theta + alpha * grad`` (``"scalar"``), or ``alpha * g_k`` added to the first
+  largest component only, zeros added to the others (``"coordinate"``).
+
+The loop stops after the first batch whose gradient or new parameters are not finite; the
+caller decides what that means.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+from numba import njit
+
+from safepg.envs._lqg_kernel import (
+    lqg1d_gradient_samples_serial,
+    lqg2d_gradient_samples_serial,
+    lqg_gradient_samples_serial,
+)
+
+#: NumPy's pairwise summation: blocks of at most 128 terms, each summed with 8 accumulators.
+_BLOCK = 128
+_UNROLL = 8
+
+
+@njit(cache=True)
+def _block_sum(a, lo, n):  # pragma: no cover - numba
+    """NumPy's sum of a block of at most 128 terms: in order below 8, else 8 running sums."""
+    if n < _UNROLL:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = _UNROLL
+    whole = n - n % _UNROLL
+    while i < whole:
+        j = lo + i
+        r0 += a[j]
+        r1 += a[j + 1]
+        r2 += a[j + 2]
+        r3 += a[j + 3]
+        r4 += a[j + 4]
+        r5 += a[j + 5]
+        r6 += a[j + 6]
+        r7 += a[j + 7]
+        i += _UNROLL
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _pairwise(a, n):  # pragma: no cover - numba
+    """NumPy's recursion (a block, or the sum of the two halves, the first a multiple of 8 terms),
+    walked with an explicit stack: numba cannot load a cached recursive function."""
+    if n <= _BLOCK:
+        return _block_sum(a, 0, n)
+    depth = 64  # halving from 2^63 terms reaches a block in fewer levels
+    los = np.empty(depth, np.int64)
+    ns = np.empty(depth, np.int64)
+    phase = np.zeros(depth, np.int64)  # 0: left half to sum, 1: right half to sum, 2: both summed
+    left = np.empty(depth)
+    top, ret = 0, 0.0
+    los[0], ns[0] = 0, n
+    while top >= 0:
+        lo, size = los[top], ns[top]
+        if size <= _BLOCK:
+            ret = _block_sum(a, lo, size)
+            top -= 1
+            continue
+        half = size // 2
+        half -= half % _UNROLL
+        if phase[top] == 0:
+            phase[top] = 1
+            top += 1
+            los[top], ns[top], phase[top] = lo, half, 0
+        elif phase[top] == 1:
+            left[top] = ret
+            phase[top] = 2
+            top += 1
+            los[top], ns[top], phase[top] = lo + half, size - half, 0
+        else:
+            ret = left[top] + ret
+            top -= 1
+    return ret
+
+
+@njit(cache=True)
+def pairwise_sum(a):  # pragma: no cover - numba
+    """``a.sum()`` of a contiguous 1-D float array, in NumPy's order: 0.0 plus the pairwise sum."""
+    return 0.0 + _pairwise(a, a.size)
+
+
+@njit(cache=True)
+def column_means(samples, n):  # pragma: no cover - numba
+    m = samples.shape[1]
+    out = np.zeros(m)
+    if m == 1:
+        out[0] = pairwise_sum(np.ascontiguousarray(samples[:, 0]))
+    else:
+        for i in range(samples.shape[0]):
+            for j in range(m):
+                out[j] += samples[i, j]
+    for j in range(m):
+        out[j] = out[j] / n
+    return out
+
+
+@njit(cache=True)
+def _all_finite(x):  # pragma: no cover - numba
+    for v in x.ravel():
+        if not np.isfinite(v):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _step(theta, grad, alpha, coordinate):  # pragma: no cover - numba
+    delta = np.zeros_like(grad)
+    if coordinate:
+        k = 0
+        for j in range(1, grad.size):
+            if abs(grad[j]) > abs(grad[k]):
+                k = j
+        delta[k] = alpha * grad[k]
+    else:
+        for j in range(grad.size):
+            delta[j] = alpha * grad[j]
+    return theta + delta
+
+
+# One adapter per kernel, with the loop's arguments: the flat parameters and the policy's factors.
+@njit(cache=True)
+def _samples_1d(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
+                baseline):  # pragma: no cover - numba
+    return lqg1d_gradient_samples_serial(theta[0], L[0, 0], A[0, 0], B[0, 0], Q[0, 0], R[0, 0], key, n, H, gamma,
+                                         bs, ba, clip, score_clipped, reinforce_estimator, baseline)
+
+
+@njit(cache=True)
+def _samples_2d(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
+                baseline):  # pragma: no cover - numba
+    K = theta.reshape(Pm.shape[0], theta.size // Pm.shape[0])
+    return lqg2d_gradient_samples_serial(K, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped,
+                                         reinforce_estimator, baseline)
+
+
+@njit(cache=True)
+def _samples_any(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
+                 baseline):  # pragma: no cover - numba
+    K = theta.reshape(Pm.shape[0], theta.size // Pm.shape[0])
+    return lqg_gradient_samples_serial(K, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped,
+                                       reinforce_estimator, baseline)
+
+
+def _samples(*args):  # pragma: no cover - replaced by one of the adapters in each compiled loop
+    raise NotImplementedError
+
+
+def _batches(theta, L, Pm, A, B, Q, R, keys, sizes, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
+             baseline, alpha, coordinate):  # pragma: no cover - numba
+    """Batch i draws ``sizes[i]`` trajectories with key ``keys[i]`` from ``theta_i`` and steps to
+    ``theta_{i+1}``.
+
+    ``theta`` is the flat start (m,), the gain row-major. Returns ``thetas`` (b + 1, m),
+    ``grads`` (b, m) and ``j_hat`` (b,) for the b batches drawn: all of them, or up to the first
+    whose gradient is not finite (then ``thetas`` has b rows) or whose new parameters are not
+    (their row is the last).
+    """
+    b_max = keys.size
+    m = theta.size
+    thetas = np.empty((b_max + 1, m))
+    grads = np.empty((b_max, m))
+    j_hat = np.empty(b_max)
+    thetas[0] = theta
+    for i in range(b_max):
+        n = sizes[i]
+        samples, returns = _samples(theta, L, Pm, A, B, Q, R, keys[i], n, H, gamma, bs, ba, clip, score_clipped,
+                                    reinforce_estimator, baseline)
+        grad = column_means(samples, n)
+        grads[i] = grad
+        j_hat[i] = pairwise_sum(returns) / n
+        if not _all_finite(grad):
+            return thetas[:i + 1], grads[:i + 1], j_hat[:i + 1]
+        theta = _step(theta, grad, alpha, coordinate)
+        thetas[i + 1] = theta
+        if not _all_finite(theta):
+            return thetas[:i + 2], grads[:i + 1], j_hat[:i + 1]
+    return thetas, grads, j_hat
+
+
+def _compiled(samples, name):
+    """:func:`_batches` compiled around one adapter (its own entry in numba's cache), so that a
+    run compiles the kernel of its dimension only."""
+    g = types.FunctionType(_batches.__code__, {**globals(), "_samples": samples}, name)
+    g.__qualname__ = name
+    g.__doc__ = _batches.__doc__
+    return njit(cache=True, error_model="numpy")(g)
+
+
+#: The loop by the LQG's state dimension (0: any other).
+FIXED_STEP_BATCHES = {1: _compiled(_samples_1d, "fixed_step_batches_1d"),
+                      2: _compiled(_samples_2d, "fixed_step_batches_2d"),
+                      0: _compiled(_samples_any, "fixed_step_batches")}
