@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from safepg import portable
 from safepg.bounds import ErrorBound
@@ -155,8 +156,9 @@ def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = Non
 
     Start at ceil(N_0) and stop as soon as Upsilon begins to decrease; the stationary
     point is unique (Descartes' rule of signs), so this is the global maximiser on
-    [N_0, inf). The search is evaluated in growing vectorised chunks; with ``n_max``
-    it stops there (larger batch sizes would be clipped anyway).
+    [N_0, inf). With ``n_max`` it stops there (larger batch sizes would be clipped anyway).
+    The search is compiled and evaluates Upsilon with the operations of :func:`upsilon`, so it
+    finds the N* of evaluating :func:`upsilon` on every N, bit for bit.
     """
     g = _check_g(g)
     if g == 0:
@@ -164,20 +166,32 @@ def n_star_search(g: float, bound: ErrorBound, c: float, n_max: int | None = Non
     start = max(1, math.ceil(n_zero(g, bound)))
     if n_max is not None and start >= n_max:
         return n_max
-    chunk = 1024
-    while True:
-        stop = start + chunk + 1
-        if n_max is not None:
-            stop = min(stop, n_max + 1)
-        ns = np.arange(start, stop, dtype=float)
-        vals = upsilon(ns, g, bound, c)
-        drops = np.nonzero(np.diff(vals) < 0)[0]
-        if drops.size:
-            return int(ns[drops[0]])
-        if n_max is not None and stop == n_max + 1:
-            return n_max
-        start = int(ns[-1])
-        chunk *= 2
+    return int(_first_decrease(start, -1 if n_max is None else int(n_max), g, float(bound.d), float(bound.f),
+                               float(c)))
+
+
+@njit(cache=True)
+def _upsilon_at(n: float, g: float, d: float, f: float, c: float) -> float:  # pragma: no cover - numba
+    # upsilon() at one N, operation for operation (the same bits): eps(N), then the quotient.
+    eps = d / np.sqrt(n) + f / n
+    lo, hi = g - eps, g + eps
+    val = (lo * lo) * (lo * lo) / (4 * c * n * (hi * hi))
+    return val if eps < g else 0.0
+
+
+@njit(cache=True)
+def _first_decrease(start: int, n_max: int, g: float, d: float, f: float, c: float) -> int:  # pragma: no cover
+    # The first N >= start with Upsilon(N + 1) < Upsilon(N), or n_max (>= 0) if none is below it.
+    # Compiled: the adaptive loop runs this search after every batch of a Bernstein run.
+    n = start
+    v = _upsilon_at(float(n), g, d, f, c)
+    while n_max < 0 or n < n_max:
+        w = _upsilon_at(float(n + 1), g, d, f, c)
+        if w - v < 0:
+            return n
+        n += 1
+        v = w
+    return n_max
 
 
 def n_star_bernstein_root(g: float, bound: ErrorBound) -> float:

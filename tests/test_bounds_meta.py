@@ -118,6 +118,23 @@ def test_bernstein_search_returns_grid_argmax(d, f, g, c):
     assert abs(n - root) <= 1
 
 
+@settings(max_examples=200, deadline=None)
+@given(d=pos, f=pos, g=pos, c=pos, n_max=st.one_of(st.none(), st.integers(2, 200_000)))
+def test_bernstein_search_is_the_first_decrease_of_upsilon(d, f, g, c, n_max):
+    # The compiled search against upsilon() on the whole grid, in NumPy: the first N whose successor
+    # has a smaller Upsilon, where rounding decides near the top, so it must match bit for bit.
+    bound = ErrorBound(d, f)
+    root = n_star_bernstein_root(g, bound)
+    if root > 2_000_000:
+        return
+    start = max(1, math.ceil(n_zero(g, bound)))
+    stop = 3 * math.ceil(root) + 10 if n_max is None else n_max
+    grid = np.arange(start, max(stop, start) + 1, dtype=float)
+    drops = np.nonzero(np.diff(upsilon(grid, g, bound, c)) < 0)[0]
+    expected = int(grid[drops[0]]) if drops.size else n_max
+    assert n_star_search(g, bound, c, n_max) == expected
+
+
 def test_search_agrees_with_closed_form_when_f_is_zero():
     for d, g in [(3.0, 0.5), (100.0, 7.0), (0.4, 0.01)]:
         b = ErrorBound(d)

@@ -53,6 +53,22 @@ def test_fixed_step_run_is_seeded_and_counts_batches():
     np.testing.assert_array_equal(ts.fixed_step_run(ENV, -0.55, 1.0, 100, 0.0, 1000, 3), np.full(11, -0.55))
 
 
+@pytest.mark.parametrize("baseline,score,alpha", [("none", "raw", 1e-3), ("optimal", "clipped", 1e-3),
+                                                  ("average", "clipped", 1e-3), ("optimal", "clipped", 1e6)])
+def test_fixed_step_run_is_the_loop_of_batch_gradients(baseline, score, alpha):
+    # The compiled run against batch_gradient called batch by batch, bit for bit; alpha = 1e6
+    # diverges, and both stop before the first non-finite parameter.
+    rng, theta, path = np.random.default_rng(11), -0.55, [-0.55]
+    for _ in range(300):
+        g, _ = ts.batch_gradient(ENV, theta, 1.0, 20, rng, baseline, score)
+        if not (np.isfinite(g) and np.isfinite(theta + alpha * g)):
+            break
+        theta = theta + alpha * g
+        path.append(theta)
+    assert ts.fixed_step_run(ENV, -0.55, 1.0, 20, alpha, 6000, 11, baseline, score).tolist() == path
+    assert (len(path) < 301) == (alpha == 1e6)
+
+
 def test_fixed_step_run_stops_when_theta_diverges():
     path = ts.fixed_step_run(ENV, -0.55, 1.0, 10, 1e6, 10_000, 0)
     assert path.size < 1001 and np.all(np.isfinite(path))
