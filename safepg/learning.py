@@ -241,13 +241,12 @@ def _learn_fixed_step(
         warnings.warn(f"interrupted after {used} trajectories; returning the partial record", stacklevel=2)
     finally:
         bar.close()
-    b = sum(j.size for j in j_hats)
-    m = policy.theta.size
-    rows = {"batch_size": sizes[:b], "alpha": np.full(b, float(step.alpha)), "J_hat": np.concatenate([[], *j_hats]),
-            "grad": np.concatenate([np.empty((0, m)), *grads]), "eps": np.zeros(b), "safe": np.ones(b, dtype=bool),
-            "coordinate": np.full(b, -1 if step.kind == "scalar" else 0, dtype=np.int64)}
-    if step.kind == "coordinate":
-        rows["coordinate"] = np.argmax(np.abs(rows["grad"]), axis=1) if b else rows["coordinate"]
+    grad = np.concatenate([np.empty((0, policy.theta.size)), *grads])
+    b = grad.shape[0]
+    # The rule's k: the first largest |component| moves ("coordinate"); -1 when all of them do.
+    coordinate = np.argmax(np.abs(grad), axis=1) if step.kind == "coordinate" else np.full(b, -1)
+    rows = {"batch_size": sizes[:b], "alpha": np.full(b, float(step.alpha)), "coordinate": coordinate,
+            "J_hat": np.concatenate([[], *j_hats]), "grad": grad, "eps": np.zeros(b), "safe": np.ones(b, dtype=bool)}
     return _record(hooks, policy.sigma, np.concatenate(thetas), rows, config, interrupted=interrupted,
                    diverged=diverged, reached_target=False)
 
@@ -382,6 +381,10 @@ def vanilla_pg(
     overflows: with ``stop_on_divergence=True`` the run then ends and the record says so
     (``diverged``), instead of raising.
 
+    A fixed step without a target runs in the task's compiled loop when it has one
+    (:class:`~safepg.tasks.FixedStepBatches`, as the LQG does), with the same numbers; a
+    callable ``progress``, which is called after every batch, keeps the loop in Python.
+
     Parameters
     ----------
     task : Task
@@ -479,5 +482,5 @@ def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0
     raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "Progress", "RecordFileError", "adaptive_pg", "guaranteed_improvement",
-           "learn", "vanilla_pg"]
+__all__ = ["CHECKPOINTS", "FUSED_TRAJECTORIES", "LearningRecord", "Progress", "RecordFileError", "adaptive_pg",
+           "guaranteed_improvement", "learn", "vanilla_pg"]
