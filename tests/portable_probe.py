@@ -39,6 +39,8 @@ def runs() -> dict[str, list[LearningRecord]]:
         "1d-hoeffding": [adaptive_pg(lqg1, error=ErrorModel("hoeffding"), budget=30_000, rng=0)],
         "1d-vanilla-raw": [vanilla_pg(lqg1, -0.55, 0.5, batch_size=100, step=FixedStep(1e-3),
                                       gradient=Gradient(score_action="raw"), budget=20_000, rng=0)],
+        "2d-vanilla-fixed": [vanilla_pg(lqg2, np.zeros(4), batch_size=100, step=FixedStep(1e-6, "coordinate"),
+                                        budget=20_000, rng=0)],
         "2d-scalar-step": [vanilla_pg(lqg2, np.zeros(4), batch_size=500, step=SafeStep("scalar"),
                                       budget=20_000, rng=0)],
         "2d-bernstein": [adaptive_pg(lqg2, np.zeros(4), error=bernstein_er, budget=30_000, rng=0)],

@@ -145,7 +145,8 @@ def _step(theta, grad, alpha, coordinate):  # pragma: no cover - numba
     return theta + delta
 
 
-# One adapter per kernel, with the loop's arguments: the flat parameters and the policy's factors.
+# The adapters from the loop's arguments (the flat parameters, the policy's factors) to a kernel's:
+# the 1-D kernel's scalars, or the gain matrix of the 2-D and the generic kernels.
 @njit(cache=True)
 def _samples_1d(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
                 baseline):  # pragma: no cover - numba
@@ -153,20 +154,14 @@ def _samples_1d(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_
                                          bs, ba, clip, score_clipped, reinforce_estimator, baseline)
 
 
-@njit(cache=True)
-def _samples_2d(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
-                baseline):  # pragma: no cover - numba
+def _matrix_samples(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
+                    baseline):  # pragma: no cover - numba
     K = theta.reshape(Pm.shape[0], theta.size // Pm.shape[0])
-    return lqg2d_gradient_samples_serial(K, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped,
-                                         reinforce_estimator, baseline)
+    return _kernel(K, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator, baseline)
 
 
-@njit(cache=True)
-def _samples_any(theta, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped, reinforce_estimator,
-                 baseline):  # pragma: no cover - numba
-    K = theta.reshape(Pm.shape[0], theta.size // Pm.shape[0])
-    return lqg_gradient_samples_serial(K, L, Pm, A, B, Q, R, key, n, H, gamma, bs, ba, clip, score_clipped,
-                                       reinforce_estimator, baseline)
+def _kernel(*args):  # pragma: no cover - replaced by a matrix kernel in each compiled adapter
+    raise NotImplementedError
 
 
 def _samples(*args):  # pragma: no cover - replaced by one of the adapters in each compiled loop
@@ -205,16 +200,21 @@ def _batches(theta, L, Pm, A, B, Q, R, keys, sizes, H, gamma, bs, ba, clip, scor
     return thetas, grads, j_hat
 
 
-def _compiled(samples, name):
-    """:func:`_batches` compiled around one adapter (its own entry in numba's cache), so that a
-    run compiles the kernel of its dimension only."""
-    g = types.FunctionType(_batches.__code__, {**globals(), "_samples": samples}, name)
+def _compiled(function, name, **names):
+    """``function`` compiled with some of its global ``names`` bound to other compiled functions,
+    under its own ``name`` (its own entry in numba's cache): a run compiles only the kernel of its
+    dimension."""
+    g = types.FunctionType(function.__code__, {**globals(), **names}, name)
     g.__qualname__ = name
-    g.__doc__ = _batches.__doc__
+    g.__doc__ = function.__doc__
     return njit(cache=True, error_model="numpy")(g)
 
 
 #: The loop by the LQG's state dimension (0: any other).
-FIXED_STEP_BATCHES = {1: _compiled(_samples_1d, "fixed_step_batches_1d"),
-                      2: _compiled(_samples_2d, "fixed_step_batches_2d"),
-                      0: _compiled(_samples_any, "fixed_step_batches")}
+FIXED_STEP_BATCHES = {
+    1: _compiled(_batches, "fixed_step_batches_1d", _samples=_samples_1d),
+    2: _compiled(_batches, "fixed_step_batches_2d",
+                 _samples=_compiled(_matrix_samples, "_samples_2d", _kernel=lqg2d_gradient_samples_serial)),
+    0: _compiled(_batches, "fixed_step_batches",
+                 _samples=_compiled(_matrix_samples, "_samples_any", _kernel=lqg_gradient_samples_serial)),
+}
