@@ -98,7 +98,8 @@ def test_a_further_optional_parameter_is_allowed():
 @pytest.mark.parametrize("name,proto", [("measured_returns", "MeasuredReturns"), ("performance", "Performance"),
                                         ("gradient_batch", "GradientBatch"),
                                         ("performance_batch", "PerformanceBatch"),
-                                        ("gradient_batch_constants", "GradientBatchConstants")])
+                                        ("gradient_batch_constants", "GradientBatchConstants"),
+                                        ("fixed_step_batches", "FixedStepBatches")])
 def test_a_hook_defined_without_being_declared_is_refused(name, proto):
     Undeclared = type("Undeclared", (Minimal,), {name: lambda self, *a: None})
     with pytest.raises(TypeError, match=f"defines {name} but does not declare safepg.tasks.{proto}"):
