@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -284,11 +283,12 @@ def run_configs(
     remove_stale_temp_files(folder)
     todo = [(c, seed) for c in configs for seed in range(seeds) if stored_run(folder, c, seed, "set_aside") is None]
     # Longest runs first, so that no long run is dispatched last and leaves the other workers
-    # idle at the end: the largest budgets, and among equal budgets the smallest fixed batch
-    # sizes (more iterations, each with its per-batch overhead: Table 5.3's N = 100 runs take
-    # about twice as long as its adaptive ones). Stable: ties keep the given order.
-    todo.sort(key=lambda cs: (-cs[0].budget,
-                              cs[0].method.batch_size if isinstance(cs[0].method, Vanilla) else math.inf))
+    # idle at the end: the largest budgets; among equal budgets the adaptive runs (a Python
+    # iteration each, with the bound and the N* search: one seed of Table 5.3 takes about 12 s
+    # adaptive, 9.5 s at N = 100 and 7.5 s at N = 1000), then the smallest fixed batch sizes
+    # (more iterations). Stable: ties keep the given order.
+    todo.sort(key=lambda cs: (-cs[0].budget, isinstance(cs[0].method, Vanilla),
+                              cs[0].method.batch_size if isinstance(cs[0].method, Vanilla) else 0))
     if todo:
         started = time.perf_counter()
         n_jobs = effective_n_jobs(jobs)

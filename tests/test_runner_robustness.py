@@ -358,14 +358,15 @@ def test_a_reader_that_stops_reading_gets_no_traceback(tmp_path):
     assert "Traceback" not in err and "BrokenPipeError" not in err and "Exception ignored" not in err, err
 
 
-def test_equal_budgets_put_the_smallest_fixed_batches_first(tmp_path, monkeypatch):
-    """Table 5.3's configs (adaptive, N = 1000, N = 100 at one budget): N = 100 first, adaptive last."""
+def test_equal_budgets_put_adaptive_runs_then_the_smallest_fixed_batches_first(tmp_path, monkeypatch):
+    """Table 5.3's configs (adaptive, N = 1000, N = 100 at one budget), given in reverse: adaptive
+    first, then N = 100, then N = 1000."""
     e = ex.scaled(ex.get_experiment("table-5.3"), seeds=1, budget=2000)
     order = []
     compute = runner._compute
     monkeypatch.setattr(runner, "_compute", lambda c, *a: (order.append(c.name), compute(c, *a))[1])
-    es.run_experiment(e, jobs=1, root=tmp_path, progress=False)
-    assert order == ["N=100", "N=1000", "adaptive"]
+    es.run_experiment(replace(e, configs=e.configs[::-1]), jobs=1, root=tmp_path, progress=False)
+    assert order == ["adaptive", "N=100", "N=1000"]
 
 
 @pytest.mark.parametrize("as_text", [True, False])
