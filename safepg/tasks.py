@@ -105,8 +105,7 @@ class PerformanceBatch(Protocol):
 #: The optional methods, by the Protocol that declares each.
 METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
                                  FixedStepBatches: "fixed_step_batches", MeasuredReturns: "measured_returns",
-                                 Performance: "performance",
-                                 PerformanceBatch: "performance_batch"}
+                                 Performance: "performance", PerformanceBatch: "performance_batch"}
 
 
 @dataclass(frozen=True)
