@@ -30,6 +30,7 @@ from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep,
 from safepg.policies import LinearGaussianPolicy
 from safepg.record import CHECKPOINTS, LearningRecord, RecordFileError
 from safepg.rng import RNGLike, as_generator
+from safepg.streams import batch_keys
 from safepg.tasks import Hooks, Task, task_hooks
 from safepg.trajectories import Trajectories
 
@@ -94,6 +95,10 @@ def _check_budget(budget: int, n_first: int) -> None:
         raise ValueError(f"budget must be an integer >= the first batch size {n_first}, got {budget}")
 
 
+def _not_finite(theta: np.ndarray, grad: np.ndarray) -> ValueError:
+    return ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
+
+
 def _learn(
     task: Task,
     hooks: Hooks,
@@ -134,7 +139,7 @@ def _learn(
                 if stop_on_divergence:
                     diverged = True
                     break
-                raise ValueError(f"gradient estimate is not finite at theta={theta.tolist()}: {grad}")
+                raise _not_finite(theta, grad)
             J_hat = float(returns.sum() / n)
             reached = target is not None and J_hat >= target.value
             if reached and not (target is not None and target.update):
@@ -218,15 +223,15 @@ def _learn_fixed_step(
     try:
         for lo in range(0, sizes.size, per_call):
             group = sizes[lo:lo + per_call]
-            keys = rng.integers(0, 2**64, size=group.size, dtype=np.uint64)  # batch_key, once per batch
-            th, g, j_hat = hooks.fixed_step_batches(policy, group, keys, step.alpha, step.kind, *how)
+            th, g, j_hat = hooks.fixed_step_batches(policy, group, batch_keys(rng, group.size), step.alpha, step.kind,
+                                                    *how)
             if not np.all(np.isfinite(g[-1])):
                 if not stop_on_divergence:
-                    raise ValueError(f"gradient estimate is not finite at theta={th[-1].tolist()}: {g[-1]}")
+                    raise _not_finite(th[-1], g[-1])
                 diverged = True
                 g, j_hat = g[:-1], j_hat[:-1]
-            elif not np.all(np.isfinite(th[-1])):
-                raise ValueError("theta must be finite (got NaN or inf)")  # as LinearGaussianPolicy.with_theta
+            else:  # refuses non-finite parameters, as in the Python loop
+                policy = policy.with_theta(th[-1])
             thetas.append(th[1:])
             grads.append(g)
             j_hats.append(j_hat)
@@ -235,7 +240,6 @@ def _learn_fixed_step(
             bar.update(done)
             if diverged:
                 break
-            policy = policy.with_theta(th[-1])
     except KeyboardInterrupt:
         interrupted = True
         warnings.warn(f"interrupted after {used} trajectories; returning the partial record", stacklevel=2)

@@ -206,6 +206,12 @@ def batch_key(rng: np.random.Generator) -> np.uint64:
     return np.uint64(rng.integers(0, 2**64, dtype=np.uint64))
 
 
+def batch_keys(rng: np.random.Generator, count: int) -> np.ndarray:
+    """The keys of ``count`` consecutive batches at once: the numbers as many calls of
+    :func:`batch_key` draw (a whole-range draw takes one 64-bit output each)."""
+    return rng.integers(0, 2**64, size=int(count), dtype=np.uint64)
+
+
 @njit(cache=True, parallel=True)
 def _draws(key, n, n_uniform, n_normal):
     uniforms = np.empty((n, n_uniform))
@@ -259,5 +265,5 @@ def normal_rate_probe(key: np.uint64, streams: int, per_stream: int) -> float:
     return float(_normal_sums(np.uint64(key), int(streams), int(per_stream)).sum())
 
 
-__all__ = ["ZIGGURAT_LAYERS", "ZIGGURAT_R", "batch_key", "mix", "next_normal", "next_uint64", "next_uniform",
-           "normal_rate_probe", "stream_start", "trajectory_draws"]
+__all__ = ["ZIGGURAT_LAYERS", "ZIGGURAT_R", "batch_key", "batch_keys", "mix", "next_normal", "next_uint64",
+           "next_uniform", "normal_rate_probe", "stream_start", "trajectory_draws"]

@@ -57,7 +57,7 @@ from numba import njit
 
 from safepg.envs.lqg import LQG
 from safepg.rng import RNGLike, as_generator
-from safepg.streams import batch_key, next_normal, next_uniform, stream_start
+from safepg.streams import batch_key, batch_keys, next_normal, next_uniform, stream_start
 
 Baseline = Literal["none", "optimal", "average"]
 SigmaReading = Literal["std", "variance"]
@@ -214,8 +214,7 @@ def fixed_step_run(env: LQG, theta0: float, std: float, batch_size: int, alpha: 
         raise ValueError(f"budget must be an integer >= batch_size, got {budget}")
     _check_env(env)
     _check_options(baseline, score_action)
-    # One batch key per batch, as batch_gradient draws them (the same numbers drawn at once).
-    keys = as_generator(rng).integers(0, 2**64, size=int(budget) // int(batch_size), dtype=np.uint64)
+    keys = batch_keys(as_generator(rng), int(budget) // int(batch_size))  # batch_gradient's, drawn at once
     path: np.ndarray = _fixed_step_path(float(theta0), float(std), keys, int(batch_size), int(env.horizon),
                                         float(env.gamma), float(env.state_bound), score_action == "clipped",
                                         _BASELINE_CODES[baseline], float(alpha))
