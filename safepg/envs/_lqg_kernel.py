@@ -35,6 +35,16 @@ S1, CUM1, ACC1, RET1, Z1, DR1 = 0 * ROW, 1 * ROW, 2 * ROW, 3 * ROW, 4 * ROW, 5 *
 ROWS1 = 6
 
 
+@njit(cache=True)
+def _rows(rows, m):
+    """A chunk's ``rows`` rows of ROW entries, the first m of each zero: only those are read. Zeroing
+    whole rows (230 kB in 2-D) took 12% of a Table 5.3 run at N = 100."""
+    T = np.empty(rows * ROW)
+    for r in range(rows):
+        T[r * ROW:r * ROW + m] = 0.0
+    return T
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, clip, score_clipped,
                            reinforce_estimator, baseline):
@@ -59,7 +69,7 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
     for c in prange(n_chunks):
         lo = c * CHUNK
         m = min(N, lo + CHUNK) - lo
-        T = np.zeros(ROWS1 * ROW)
+        T = _rows(ROWS1, m)
         st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
         rejected = np.empty(m, dtype=np.bool_)
         for i in range(m):
@@ -95,13 +105,15 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
         b = _baseline(num, den)
         for c in prange(n_chunks):
             lo, hi = c * CHUNK, min(N, (c + 1) * CHUNK)
-            acc = np.zeros(hi - lo)  # sum_t G_{n,t} b_t, added in t order for each n
+            m = hi - lo
+            acc = np.zeros(m)  # sum_t G_{n,t} b_t, added in t order for each n
             for t in range(rows):
                 bt = b[t]
-                for n in range(lo, hi):
-                    acc[n - lo] += kept[t, n] * bt
-            for n in range(lo, hi):
-                samples[n, 0] -= acc[n - lo]
+                row = kept[t, lo:hi]  # a 1-D slice: the compiler vectorises this loop, not kept[t, n]
+                for i in range(m):
+                    acc[i] += row[i] * bt
+            for i in range(m):
+                samples[lo + i, 0] -= acc[i]
     return samples, returns
 
 
@@ -175,7 +187,7 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
     for c in prange(n_chunks):
         lo = c * CHUNK
         m = min(N, lo + CHUNK) - lo
-        T = np.zeros(ROWS2 * ROW)
+        T = _rows(ROWS2, m)
         st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
         rejected = np.empty(m, dtype=np.bool_)
         for i in range(m):
@@ -228,15 +240,20 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
         b = _baseline(num, den)
         for c in prange(n_chunks):
             lo, hi = c * CHUNK, min(N, (c + 1) * CHUNK)
-            acc = np.zeros((4, hi - lo))  # sum_t G_{n,t} b_t, added in t order for each n
-            for t in range(rows):
-                for p in range(4):
+            m = hi - lo
+            acc = np.empty(m)
+            # Component by component, so that the running sums stay in one short array; for each
+            # n, sum_t G_{n,t} b_t is still added in t order. One-dimensional slices: the compiler
+            # vectorises these loops, not the same loops indexing the 3-D array.
+            for p in range(4):
+                acc[:] = 0.0
+                for t in range(rows):
                     bt = b[t, p]
-                    for n in range(lo, hi):
-                        acc[p, n - lo] += kept[t, p, n] * bt
-            for n in range(lo, hi):
-                for p in range(4):
-                    samples[n, p] -= acc[p, n - lo]
+                    row = kept[t, p, lo:hi]
+                    for i in range(m):
+                        acc[i] += row[i] * bt
+                for i in range(m):
+                    samples[lo + i, p] -= acc[i]
     return samples, returns
 
 
