@@ -6,7 +6,7 @@ import numba
 import numpy as np
 import pytest
 
-from safepg.envs._lqg_kernel import CHUNK, lqg2d_gradient_samples, lqg_gradient_samples
+from safepg.envs._lqg_kernel import CHUNK, lqg1d_gradient_samples, lqg2d_gradient_samples, lqg_gradient_samples
 from safepg.envs.lqg import LQG
 from safepg.estimators import gradient_samples
 from safepg.policies import LinearGaussianPolicy
@@ -68,7 +68,9 @@ def _kernel_inputs(env, pol, n, seed):
 
 @pytest.mark.parametrize("clip,score_clipped,reinforce,baseline", FLAGS)
 def test_2d_kernel_matches_generic_kernel(clip, score_clipped, reinforce, baseline):
-    """The unrolled m = 2 kernel against the generic m x m loops on identical inputs."""
+    """The unrolled m = 2 kernel against the generic m x m loops on identical inputs, bit for bit:
+    the same terms in the same order, however the unrolled kernel's loops are vectorised (the
+    generic kernel's baseline pass is a plain loop over t for each sample)."""
     env, K, sig = CASES["2d"]
     pol = LinearGaussianPolicy(K if clip else CASES["2d-unclipped"][1], sig)
     # Two chunks, the second partial, so the chunked baseline reduction is exercised.
@@ -76,7 +78,23 @@ def test_2d_kernel_matches_generic_kernel(clip, score_clipped, reinforce, baseli
     fast, generic = lqg2d_gradient_samples(*args), lqg_gradient_samples(*args)
     assert fast[0].shape == generic[0].shape == (CHUNK + 301, 4)
     for got, want in zip(fast, generic):
-        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+        np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("case", ["1d", "1d-unclipped"])
+@pytest.mark.parametrize("clip,score_clipped,reinforce,baseline", FLAGS)
+def test_1d_kernel_matches_generic_kernel(case, clip, score_clipped, reinforce, baseline):
+    """The scalar kernel against the generic loops at m = 1, bit for bit, over two chunks."""
+    env, K, sig = CASES[case]
+    args = _kernel_inputs(env, LinearGaussianPolicy(K, sig), CHUNK + 301, 12)
+    gain, cov_chol, _, A, B, Q, R = (np.asarray(x) for x in args[:7])
+    scalars = (gain[0, 0], cov_chol[0, 0], A[0, 0], B[0, 0], Q[0, 0], R[0, 0])
+    flags = (clip, score_clipped, reinforce, baseline)
+    fast = lqg1d_gradient_samples(*(float(x) for x in scalars), *args[7:], *flags)
+    generic = lqg_gradient_samples(*args, *flags)
+    assert fast[0].shape == generic[0].shape == (CHUNK + 301, 1)
+    for got, want in zip(fast, generic):
+        np.testing.assert_array_equal(got, want)
 
 
 def test_gradient_batch_dispatch():
