@@ -151,7 +151,7 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
     and the baseline sums in index order (:func:`_sums2d`).
 
     Every sum is formed in the same order as in the generic kernel, so the two give the
-    same bits (tested to 1e-12 relative); swapping kernels does not change a seeded run.
+    same bits (tested bit for bit, as is the 1-D kernel); swapping kernels does not change a seeded run.
     That rules out regrouping the cost quadratic forms to save a few multiplies.
 
     Parameters
