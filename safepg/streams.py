@@ -157,23 +157,89 @@ def normal_redraw(state: np.uint64) -> tuple[float, np.uint64]:
 
 
 @njit(cache=True)
-def draw_normals(st: np.ndarray, out: np.ndarray, start: int, rejected: np.ndarray, n: int) -> None:
+def normal_scratch(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Scratch space for :func:`draw_normals` on up to ``n`` streams: (flags, indices, values)."""
+    return np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.intp), np.empty(n)
+
+
+@njit(cache=True)
+def draw_normals(st: np.ndarray, out: np.ndarray, start: int, scratch: tuple[np.ndarray, np.ndarray, np.ndarray],
+                 n: int) -> None:
     """One standard normal from each of the streams ``st[:n]``, into ``out[start:start + n]``.
 
-    The ziggurat's first comparison runs for the whole array in one branch-free loop, which
-    the compiler vectorises; the 1.5% of draws it rejects are finished one by one afterwards
-    (``rejected`` is scratch space of n flags). Each stream's numbers are those of
-    :func:`next_normal`.
+    Each stream's numbers are those of :func:`next_normal`, drawn in three passes that the
+    compiler vectorises where it matters:
+
+    1. the ziggurat's first comparison for the whole array, branch-free;
+    2. the wedge test of the 1.5% of draws it rejects, gathered by index, also branch-free
+       (:func:`_wedge_test`; about half pass);
+    3. the rest finished one by one (:func:`_after_wedge`).
+
+    ``scratch`` is :func:`normal_scratch` of at least n.
     """
+    rejected, redo, xs = scratch
     n_rejected = 0
     for j in range(n):
         out[start + j], st[j], accepted = normal_candidate(st[j])
         rejected[j] = not accepted
         n_rejected += not accepted
-    if n_rejected:
-        for j in range(n):
-            if rejected[j]:
-                out[start + j], st[j] = normal_redraw(st[j])
+    if n_rejected == 0:
+        return
+    # The rejected indices, in order. Eight flags are tested at once: one branch per eight
+    # draws, rarely taken, instead of one per draw.
+    m = 0
+    whole = n // 8
+    words = rejected[:whole * 8].view(np.uint64)
+    for w in range(whole):
+        if words[w]:
+            for j in range(8 * w, 8 * w + 8):
+                redo[m] = j
+                m += rejected[j]
+    for j in range(whole * 8, n):
+        redo[m] = j
+        m += rejected[j]
+    passed = rejected  # the flags are read: their space holds the wedge tests' outcomes
+    for k in range(m):
+        xs[k], passed[k] = _wedge_test(st[redo[k]])
+    for k in range(m):
+        j = redo[k]
+        if passed[k]:
+            out[start + j] = xs[k]
+            st[j] = st[j] + _GAMMA_DRAW  # the wedge test's uniform
+        else:
+            out[start + j], st[j] = _after_wedge(st[j])
+
+
+@njit(cache=True)
+def _wedge_test(state: np.uint64) -> tuple[float, bool]:
+    """The first wedge test of a draw that :func:`normal_candidate` rejected, from the stream's
+    state after that draw: (x, passed). Branch-free; the base strip (layer 0) never passes here.
+    :func:`_normal_slow`'s first test, with :func:`safepg.portable.exp_in_range` for its
+    exponential: |x| is below 4, so -x^2/2 is in its range and the bits are exp_kernel's."""
+    bits = mix(state)
+    idx = np.intp(bits & np.uint64(0xFF))
+    x = float(np.int64(bits) >> np.int64(11)) * _W[idx]
+    u, _ = next_uniform(state)
+    i = max(int(idx), 1)  # layer 0's test is the tail's, not this one: any in-bounds index will do
+    return x, (idx != 0) & ((_F[i - 1] - _F[i]) * u + _F[i] < portable.exp_in_range(-0.5 * x * x))
+
+
+@njit(cache=True)
+def _after_wedge(state: np.uint64) -> tuple[float, np.uint64]:
+    """The normal of a draw whose first wedge test failed (or whose layer is the base strip),
+    from the stream's state after the rejected draw: :func:`normal_redraw` from its second test on."""
+    bits = mix(state)
+    idx = np.intp(bits & np.uint64(0xFF))
+    j = np.int64(bits) >> np.int64(11)
+    if idx == 0:
+        return _normal_slow(idx, j, state)
+    _, state = next_uniform(state)  # the failed wedge test's uniform
+    bits, state = next_uint64(state)
+    idx = np.intp(bits & np.uint64(0xFF))
+    j = np.int64(bits) >> np.int64(11)
+    if np.uint64(abs(j)) < _K[idx]:
+        return float(j) * _W[idx], state
+    return _normal_slow(idx, j, state)
 
 
 @njit(cache=True)
@@ -266,4 +332,4 @@ def normal_rate_probe(key: np.uint64, streams: int, per_stream: int) -> float:
 
 
 __all__ = ["ZIGGURAT_LAYERS", "ZIGGURAT_R", "batch_key", "batch_keys", "mix", "next_normal", "next_uint64",
-           "next_uniform", "normal_rate_probe", "stream_start", "trajectory_draws"]
+           "next_uniform", "normal_rate_probe", "normal_scratch", "stream_start", "trajectory_draws"]

@@ -58,6 +58,59 @@ def test_fast_path_equals_integer_arithmetic() -> None:
     assert checked > 2900
 
 
+@numba.njit
+def _paths(st: np.ndarray) -> np.ndarray:
+    """How many draws of each stream's next normal leave :func:`draw_normals`'s passes where:
+    (first comparison, wedge test passed, finished one by one; of those in the base strip)."""
+    out = np.zeros(4, dtype=np.int64)
+    for j in range(st.size):
+        _, state, accepted = streams.normal_candidate(st[j])
+        if accepted:
+            out[0] += 1
+        else:
+            out[1 + (not streams._wedge_test(state)[1])] += 1
+            out[3] += (streams.mix(state) & np.uint64(0xFF)) == 0
+    return out
+
+
+@pytest.mark.parametrize("n", [1, 7, 8, 61, 2048])
+def test_draw_normals_equals_next_normal(n: int) -> None:
+    """The vectorised passes give each stream the numbers of next_normal, and leave its state
+    where next_normal leaves it; every path through them is taken (for n = 2048: the wedge test
+    passed and failed, the base strip's tail)."""
+    st = np.array([streams.stream_start(np.uint64(20261128), i) for i in range(n)], dtype=np.uint64)
+    ref = st.copy()
+    out, scratch = np.full(n + 3, np.nan), streams.normal_scratch(n + 5)  # scratch may be larger than n
+    paths = np.zeros(4, dtype=np.int64)
+    for _ in range(max(20, 400_000 // n)):
+        paths += _paths(st)
+        streams.draw_normals(st, out, 2, scratch, n)
+        want = np.empty(n)
+        for j in range(n):
+            want[j], ref[j] = streams.next_normal(np.uint64(ref[j]))
+        assert out[2:2 + n].view(np.uint64).tolist() == want.view(np.uint64).tolist()
+        assert st.tolist() == ref.tolist()
+    assert np.isnan(out[:2]).all() and np.isnan(out[2 + n:]).all()
+    if n == 2048:
+        assert min(paths[1], paths[2]) > 2000 and paths[3] > 50, paths
+
+
+@numba.njit
+def _exp_loop(v: np.ndarray) -> np.ndarray:
+    out = np.empty_like(v)
+    for i in range(v.size):
+        out[i] = portable.exp_in_range(v[i])
+    return out
+
+
+def test_exp_in_range_is_exp_kernel_in_a_vectorised_loop() -> None:
+    """The wedge tests' exponential, in a loop the compiler vectorises, has exp_kernel's bits."""
+    x = -0.5 * np.random.default_rng(3).uniform(-4.0, 4.0, 10_001) ** 2
+    got = _exp_loop(x)
+    assert got.view(np.uint64).tolist() == np.array([portable.exp_kernel.py_func(float(t)) for t in x]).view(
+        np.uint64).tolist()
+
+
 def test_ziggurat_layers_have_equal_areas_and_close_at_zero() -> None:
     """Rebuilt at 60 digits from r: every layer has area v, and the top one ends at x = 0
     within 10^-25 (r is right to ~28 digits), so the 256 layers tile the half-density."""

@@ -36,7 +36,7 @@ from numba import njit, prange
 
 from safepg import portable
 from safepg.envs._lqg_kernel import serial
-from safepg.streams import draw_normals, next_uniform, stream_start
+from safepg.streams import draw_normals, next_uniform, normal_scratch, stream_start
 
 #: Trajectories per chunk. Fixed (not per thread) so the reduction order, and hence every
 #: bit of the result, is the same for any thread count; small enough that N = 4000 still
@@ -160,12 +160,12 @@ def _start_chunk(lo, m, key, init_bound, S, idx, st):
 
 
 @njit(cache=True)
-def _step_chunk(n, S, st, rejected, alive, K, sigma, inv_var, score_clipped, action_bound, w, consts, x_threshold,
+def _step_chunk(n, S, st, scratch, alive, K, sigma, inv_var, score_clipped, action_bound, w, consts, x_threshold,
                 angle_threshold, semi_implicit, dt, sums, num, den):
     """Step t of a chunk's n live trajectories: the normals (:func:`safepg.streams.draw_normals`),
     the step (:func:`_advance`, A += G_t w), and with ``sums`` the chunk's baseline sums of the
     step, ``num`` = sum_j G_j^2 dt and ``den`` = sum_j G_j^2; returns how many ended."""
-    draw_normals(st, S, Z, rejected, n)
+    draw_normals(st, S, Z, scratch, n)
     n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, w, w, w, w, consts, x_threshold,
                        angle_threshold, semi_implicit)
     if sums:
@@ -374,7 +374,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
     S = np.zeros((n_chunks, ROWS * ROW))  # every chunk's packed rows
     idx = np.empty((n_chunks, CHUNK), dtype=np.intp)
     st = np.empty((n_chunks, CHUNK), dtype=np.uint64)
-    rejected = np.empty((n_chunks, CHUNK), dtype=np.bool_)
+    scratch = [normal_scratch(CHUNK) for _ in range(n_chunks)]  # draw_normals' space, a chunk each
     alive = np.empty((n_chunks, CHUNK), dtype=np.bool_)
     n_live = np.empty(n_chunks, dtype=np.intp)
     n_ended = np.zeros(n_chunks, dtype=np.intp)
@@ -407,7 +407,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
                                             alive[c], gpomdp_baseline, b, ended[c], samples, a, last_g, lengths,
                                             peak)
                 if t < H and n_live[c] > 0:
-                    n_ended[c] = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var,
+                    n_ended[c] = _step_chunk(n_live[c], S[c], st[c], scratch[c], alive[c], K, sigma, inv_var,
                                              score_clipped, action_bound, disc[t], consts, x_threshold,
                                              angle_threshold, semi_implicit, disc[t], gpomdp_baseline, num[c],
                                              den[c])
@@ -426,7 +426,7 @@ def _fused(K, sigma, half, ml, cart_mass, pole_mass, gravity, tau, key, N, H, in
             for t in range(H):
                 if n_live[c] == 0:
                     break
-                ne = _step_chunk(n_live[c], S[c], st[c], rejected[c], alive[c], K, sigma, inv_var, score_clipped,
+                ne = _step_chunk(n_live[c], S[c], st[c], scratch[c], alive[c], K, sigma, inv_var, score_clipped,
                                  action_bound, w_sample * disc[t], consts, x_threshold, angle_threshold,
                                  semi_implicit, disc[t], gpomdp_baseline, num[c], den[c])
                 n_live[c] = _close_step(c * CHUNK, n_live[c], ne, t, H, S[c], idx[c], st[c], alive[c],

@@ -20,7 +20,7 @@ import types
 import numpy as np
 from numba import njit, prange
 
-from safepg.streams import draw_normals, next_normal, next_uniform, stream_start
+from safepg.streams import draw_normals, next_normal, next_uniform, normal_scratch, stream_start
 
 CHUNK = 2048
 
@@ -71,14 +71,14 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
         m = min(N, lo + CHUNK) - lo
         T = _rows(ROWS1, m)
         st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
-        rejected = np.empty(m, dtype=np.bool_)
+        scratch = normal_scratch(m)
         for i in range(m):
             state = stream_start(key, lo + i)
             u0, st[i] = next_uniform(state)
             T[S1 + i] = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
         disc = 1.0
         for t in range(H):
-            draw_normals(st, T, Z1, rejected, m)
+            draw_normals(st, T, Z1, scratch, m)
             _step1d(m, T, theta, sigma, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator, inv_var)
             if not reinforce_estimator:
                 nt, dt = num[c, t], den[c, t]
@@ -189,7 +189,7 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
         m = min(N, lo + CHUNK) - lo
         T = _rows(ROWS2, m)
         st = np.empty(m, dtype=np.uint64)  # each trajectory's stream
-        rejected = np.empty(m, dtype=np.bool_)
+        scratch = normal_scratch(m)
         for i in range(m):
             state = stream_start(key, lo + i)
             v0, state = next_uniform(state)
@@ -198,8 +198,8 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
             T[X1 + i] = -bs + (bs + bs) * v1
         disc = 1.0
         for t in range(H):
-            draw_normals(st, T, Z0, rejected, m)  # each stream: z0, then z1
-            draw_normals(st, T, Z1_, rejected, m)
+            draw_normals(st, T, Z0, scratch, m)  # each stream: z0, then z1
+            draw_normals(st, T, Z1_, scratch, m)
             _step2d(m, T, K, L, Pm, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator)
             if not reinforce_estimator:
                 _sums2d(m, T, num[c, t], den[c, t], kept, lo, t, baseline)
