@@ -163,9 +163,8 @@ def normal_scratch(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 @njit(cache=True)
-def draw_normals(st: np.ndarray, out: np.ndarray, start: int, scratch: tuple[np.ndarray, np.ndarray, np.ndarray],
-                 n: int) -> None:
-    """One standard normal from each of the streams ``st[:n]``, into ``out[start:start + n]``.
+def draw_normals(st: np.ndarray, out: np.ndarray, scratch: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """One standard normal from each of the streams ``st[:n]``, into ``out`` (n = ``out.size``).
 
     Each stream's numbers are those of :func:`next_normal`, drawn in three passes that the
     compiler vectorises where it matters:
@@ -175,12 +174,15 @@ def draw_normals(st: np.ndarray, out: np.ndarray, start: int, scratch: tuple[np.
        (:func:`_wedge_test`; about half pass);
     3. the rest finished one by one (:func:`_after_wedge`).
 
-    ``scratch`` is :func:`normal_scratch` of at least n.
+    ``scratch`` is :func:`normal_scratch` of at least n. ``out`` is typically a slice of a
+    kernel's rows: one compiled draw_normals for every caller, where a row offset passed as a
+    constant would be compiled once per constant.
     """
     rejected, redo, xs = scratch
+    n = out.size
     n_rejected = 0
     for j in range(n):
-        out[start + j], st[j], accepted = normal_candidate(st[j])
+        out[j], st[j], accepted = normal_candidate(st[j])
         rejected[j] = not accepted
         n_rejected += not accepted
     if n_rejected == 0:
@@ -204,10 +206,10 @@ def draw_normals(st: np.ndarray, out: np.ndarray, start: int, scratch: tuple[np.
     for k in range(m):
         j = redo[k]
         if passed[k]:
-            out[start + j] = xs[k]
+            out[j] = xs[k]
             st[j] = st[j] + _GAMMA_DRAW  # the wedge test's uniform
         else:
-            out[start + j], st[j] = _after_wedge(st[j])
+            out[j], st[j] = _after_wedge(st[j])
 
 
 @njit(cache=True)

@@ -84,7 +84,7 @@ def test_draw_normals_equals_next_normal(n: int) -> None:
     paths = np.zeros(4, dtype=np.int64)
     for _ in range(max(20, 400_000 // n)):
         paths += _paths(st)
-        streams.draw_normals(st, out, 2, scratch, n)
+        streams.draw_normals(st, out[2:2 + n], scratch)
         want = np.empty(n)
         for j in range(n):
             want[j], ref[j] = streams.next_normal(np.uint64(ref[j]))

@@ -165,7 +165,7 @@ def _step_chunk(n, S, st, scratch, alive, K, sigma, inv_var, score_clipped, acti
     """Step t of a chunk's n live trajectories: the normals (:func:`safepg.streams.draw_normals`),
     the step (:func:`_advance`, A += G_t w), and with ``sums`` the chunk's baseline sums of the
     step, ``num`` = sum_j G_j^2 dt and ``den`` = sum_j G_j^2; returns how many ended."""
-    draw_normals(st, S, Z, scratch, n)
+    draw_normals(st, S[Z:Z + n], scratch)
     n_ended = _advance(n, S, alive, K, sigma, inv_var, score_clipped, action_bound, w, w, w, w, consts, x_threshold,
                        angle_threshold, semi_implicit)
     if sums:
@@ -330,8 +330,9 @@ def cartpole_gradient_samples(K: np.ndarray, sigma: float, pole_length: float, c
         state to the last one reached (the failing state, or s_H), component by component.
     """
     # One compiled specialisation only: numba compiles again (about 10 s) for every new
-    # combination of argument types, e.g. an int constant or a numpy bool flag.
-    K = np.ascontiguousarray(K, dtype=np.float64).reshape(4)
+    # combination of argument types, e.g. an int constant, a numpy bool flag or a read-only
+    # array (a policy's gain): K is always a fresh, writable copy.
+    K = np.array(K, dtype=np.float64).reshape(4)
     if int(n) != n or n < 1:
         raise ValueError(f"n must be a positive integer, got {n}")
     if int(horizon) != horizon or horizon < 1:

@@ -145,6 +145,14 @@ def _step(theta, grad, alpha, coordinate):  # pragma: no cover - numba
     return theta + delta
 
 
+@njit(cache=True)
+def _set_row(a, i, v):  # pragma: no cover - numba
+    # Element by element: ``a[i] = v`` would compile numba's broadcasting and its shape-error
+    # message (about 2 s of compilation per loop, once per cold cache).
+    for j in range(v.size):
+        a[i, j] = v[j]
+
+
 # The adapters from the loop's arguments (the flat parameters, the policy's factors) to a kernel's:
 # the 1-D kernel's scalars, or the gain matrix of the 2-D and the generic kernels.
 @njit(cache=True)
@@ -183,18 +191,18 @@ def _batches(theta, L, Pm, A, B, Q, R, keys, sizes, H, gamma, bs, ba, clip, scor
     thetas = np.empty((b_max + 1, m))
     grads = np.empty((b_max, m))
     j_hat = np.empty(b_max)
-    thetas[0] = theta
+    _set_row(thetas, 0, theta)
     for i in range(b_max):
         n = sizes[i]
         samples, returns = _samples(theta, L, Pm, A, B, Q, R, keys[i], n, H, gamma, bs, ba, clip, score_clipped,
                                     reinforce_estimator, baseline)
         grad = column_means(samples, n)
-        grads[i] = grad
+        _set_row(grads, i, grad)
         j_hat[i] = pairwise_sum(returns) / n
         if not _all_finite(grad):
             return thetas[:i + 1], grads[:i + 1], j_hat[:i + 1]
         theta = _step(theta, grad, alpha, coordinate)
-        thetas[i + 1] = theta
+        _set_row(thetas, i + 1, theta)
         if not _all_finite(theta):
             return thetas[:i + 2], grads[:i + 1], j_hat[:i + 1]
     return thetas, grads, j_hat

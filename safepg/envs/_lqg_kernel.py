@@ -78,7 +78,7 @@ def lqg1d_gradient_samples(theta, sigma, A, B, Q, R, key, N, H, gamma, bs, ba, c
             T[S1 + i] = -bs + (bs + bs) * u0  # uniform on [-bs, bs), as numpy's uniform(-bs, bs)
         disc = 1.0
         for t in range(H):
-            draw_normals(st, T, Z1, scratch, m)
+            draw_normals(st, T[Z1:Z1 + m], scratch)
             _step1d(m, T, theta, sigma, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator, inv_var)
             if not reinforce_estimator:
                 nt, dt = num[c, t], den[c, t]
@@ -198,8 +198,8 @@ def lqg2d_gradient_samples(K, L, Pm, A, B, Q, R, key, N, H, gamma, bs, ba, clip,
             T[X1 + i] = -bs + (bs + bs) * v1
         disc = 1.0
         for t in range(H):
-            draw_normals(st, T, Z0, scratch, m)  # each stream: z0, then z1
-            draw_normals(st, T, Z1_, scratch, m)
+            draw_normals(st, T[Z0:Z0 + m], scratch)  # each stream: z0, then z1
+            draw_normals(st, T[Z1_:Z1_ + m], scratch)
             _step2d(m, T, K, L, Pm, A, B, Q, R, disc, bs, ba, clip, score_clipped, reinforce_estimator)
             if not reinforce_estimator:
                 _sums2d(m, T, num[c, t], den[c, t], kept, lo, t, baseline)

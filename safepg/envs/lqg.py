@@ -374,7 +374,9 @@ class LQG(GradientBatch, FixedStepBatches, Performance, PerformanceBatch, Action
             kernel = kernels.lqg2d_gradient_samples_serial if serial else kernels.lqg2d_gradient_samples
         else:
             kernel = kernels.lqg_gradient_samples_serial if serial else kernels.lqg_gradient_samples
-        out = kernel(policy.gain, policy.cov_chol, policy.precision, A, B, Q, R, *head, *flags)
+        # Writable copies: numba would compile the kernel again for a read-only array (a policy's gain).
+        K, L, P = (np.array(a, dtype=np.float64) for a in (policy.gain, policy.cov_chol, policy.precision))
+        out = kernel(K, L, P, A, B, Q, R, *head, *flags)
         return out
 
     def fixed_step_batches(
