@@ -27,7 +27,7 @@ import json
 import os
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import KW_ONLY, dataclass, field
+from dataclasses import KW_ONLY, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -305,6 +305,59 @@ def run_configs(
     return load_configs(configs, seeds, folder)
 
 
+def _shape(d: Any) -> Any:
+    """A definition's structure: its keys, strings and flags, and the length of its lists, not its numbers."""
+    if isinstance(d, Mapping):
+        return tuple((k, _shape(v)) for k, v in sorted(d.items()))
+    if isinstance(d, list | tuple):
+        return tuple(_shape(v) for v in d)
+    return d if d is None or isinstance(d, bool | str) else type(d).__name__
+
+
+def _first_batch(cfg: RunConfig) -> int:
+    return cfg.method.batch_size if isinstance(cfg.method, Vanilla) else cfg.method.batches.first_size
+
+
+def _short_runs(configs: Sequence[RunConfig]) -> int:
+    """Two batches of each config, on one thread, nothing kept: what compiles their kernels."""
+    import numba
+
+    numba.set_num_threads(1)
+    for c in configs:
+        replace(c, budget=2 * _first_batch(c)).run(0)
+    return len(configs)
+
+
+def compile_once(configs: Sequence[RunConfig], jobs: int = -1) -> int:
+    """Compile the numba kernels that ``configs`` run, each in one worker, before a campaign runs them.
+
+    Numba compiles a kernel in every process that calls it before it is in numba's cache
+    (``safepg/__pycache__``); on a cold cache, the workers of :func:`run_configs` all compile
+    the same kernels at once, and one core's work is wasted per extra worker. Here the configs
+    are grouped by task family (task type and dimension: the same kernels), and each family
+    compiles in one joblib worker, the families side by side: two batches of one config of each
+    distinct kind (:func:`_shape` of its definition). The kernels go to numba's cache; the
+    campaign's workers then load them. Nothing is stored, and no number of a campaign depends
+    on it. Warm-started configs are left out (they run their start run's kernels).
+
+    Returns the number of short runs made.
+    """
+    from joblib import Parallel, delayed, effective_n_jobs
+
+    families: dict[Any, dict[Any, RunConfig]] = {}
+    for c in configs:
+        if c.warm_start is not None:
+            continue
+        d = c.definition(exact=False)
+        family = (d["task"].get("type"), d["task"].get("dim"))
+        families.setdefault(family, {}).setdefault(_shape([d["task"], d["method"]]), c)
+    groups = sorted((list(f.values()) for f in families.values()), key=len, reverse=True)
+    n_jobs = min(effective_n_jobs(jobs), len(groups))
+    if n_jobs < 2:  # one family, or one worker: each kernel is compiled once anyway
+        return 0
+    return sum(Parallel(n_jobs=n_jobs)(delayed(_short_runs)(g) for g in groups))
+
+
 #: One line per call of :func:`run_configs` that computed runs in a folder: how long it took.
 TIMING_FILE = "timing.jsonl"
 
@@ -318,5 +371,5 @@ def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
         f.write(line + "\n")
 
 
-__all__ = ["RESULTS_VERSION", "RunConfig", "TIMING_FILE", "load_configs", "make_env", "record_timing", "run_configs",
-           "run_path", "store_run", "stored_run"]
+__all__ = ["RESULTS_VERSION", "RunConfig", "TIMING_FILE", "compile_once", "load_configs", "make_env", "record_timing",
+           "run_configs", "run_path", "store_run", "stored_run"]

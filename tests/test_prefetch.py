@@ -169,6 +169,26 @@ def test_whole_book_run_on_a_small_plan(tmp_path, monkeypatch, capsys):
     assert lines[-1].startswith("run-book: 0 computed, 1 already stored, in ")
 
 
+def test_kernels_compile_once_for_what_is_left_to_compute(tmp_path, monkeypatch):
+    """Before the tasks, runner.compile_once gets the configs with runs to compute, and only those."""
+    calls = []
+
+    def compile_once(configs, jobs=-1):
+        calls.append([c.name for c in configs])
+        return len(configs)
+
+    monkeypatch.setattr(prefetch.runner, "compile_once", compile_once)
+    tasks = [_small(), prefetch.Task("lqg2d", "table-5.3", seeds=1, budget=20_000)]
+    prefetch.prefetch_experiment(tasks[0], tmp_path, jobs=1, stream=io.StringIO(), tty=False)
+    out = io.StringIO()
+    prefetch.prefetch(BOOK, tmp_path, jobs=1, stream=out, tty=False, tasks=tasks)
+    assert calls == [["adaptive", "N=1000", "N=100"]]
+    assert out.getvalue().splitlines()[1].startswith("run-book: kernels compiled once, each task family in one worker")
+    again = io.StringIO()
+    prefetch.prefetch(BOOK, tmp_path, jobs=1, stream=again, tty=False, tasks=tasks)
+    assert calls[-1] == [] and "compiled" not in again.getvalue()
+
+
 def test_an_interrupted_task_says_stopped(tmp_path, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

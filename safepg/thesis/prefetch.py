@@ -425,6 +425,22 @@ def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: b
     return "computed"
 
 
+def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
+    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute."""
+    configs = []
+    for t in tasks:
+        if t.kind == "experiment":
+            exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
+            folder = experiment_folder(exp, root)
+            # A file's presence is enough here (a stale or damaged one is recomputed all the same).
+            configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
+                                                          for k in range(exp.seeds))]
+    started = time.monotonic()
+    if runner.compile_once(configs, jobs):
+        _say(stream, "kernels compiled once, each task family in one worker, in "
+                     f"{_duration(time.monotonic() - started)}")
+
+
 def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream: TextIO | None = None,
              tty: bool | None = None, interval: float | None = None,
              tasks: list[Task] | None = None) -> dict[str, str]:
@@ -435,6 +451,7 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
     tasks = book_tasks(book) if tasks is None else tasks
     started = time.monotonic()
     _say(stream, f"{len(tasks)} computation{'s' * (len(tasks) != 1)} the chapters need, stored in {root}")
+    _compile_once(tasks, root, jobs, stream)
     done = {}
     for t in tasks:
         kw: dict[str, Any] = dict(stream=stream, tty=tty, interval=interval, book=book)
