@@ -335,10 +335,11 @@ def compile_once(configs: Sequence[RunConfig], jobs: int = -1) -> int:
     (``safepg/__pycache__``); on a cold cache, the workers of :func:`run_configs` all compile
     the same kernels at once, and one core's work is wasted per extra worker. Here the configs
     are grouped by task family (task type and dimension: the same kernels), and each family
-    compiles in one joblib worker, the families side by side: two batches of one config of each
-    distinct kind (:func:`_shape` of its definition). The kernels go to numba's cache; the
-    campaign's workers then load them. Nothing is stored, and no number of a campaign depends
-    on it. Warm-started configs are left out (they run their start run's kernels).
+    compiles in one joblib worker, the families side by side: two batches of one config of
+    each distinct kind (the structure of its definition: its keys, strings and flags, not its
+    numbers). The kernels go to numba's cache; the campaign's workers then load them. Nothing
+    is stored, and no number of a campaign depends on it. Warm-started configs are left out
+    (they run their start run's kernels).
 
     Returns the number of short runs made.
     """
