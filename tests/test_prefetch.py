@@ -13,7 +13,7 @@ import pytest
 from safepg.cli import main
 from safepg.envs.lqg import LQG
 from safepg.thesis import prefetch, safety_store, table51_sweep
-from safepg.thesis.budget import CHAPTER_EXPERIMENTS
+from safepg.thesis.budget import CHAPTER_EXPERIMENTS, compile_seconds
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiments import EXPERIMENTS, get_experiment
 from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS
@@ -187,6 +187,10 @@ def test_kernels_compile_once_for_what_is_left_to_compute(tmp_path, monkeypatch)
     again = io.StringIO()
     prefetch.prefetch(BOOK, tmp_path, jobs=1, stream=again, tty=False, tasks=tasks)
     assert calls[-1] == [] and "compiled" not in again.getvalue()
+    # The time it took, once: bench_book.py reads it.
+    timing = (tmp_path / prefetch.COMPILE_ONCE / "timing.jsonl").read_text().splitlines()
+    assert len(timing) == 1 and json.loads(timing[0])["runs"] == 3
+    assert compile_seconds(tmp_path) == json.loads(timing[0])["seconds"]
 
 
 def test_an_interrupted_task_says_stopped(tmp_path, monkeypatch):

@@ -135,6 +135,14 @@ def safety_work(root: Path) -> list[Work]:
     return out
 
 
+def compile_seconds(root: Path) -> float | None:
+    """The seconds ``run-book`` spent compiling the kernels once before its tasks
+    (:func:`safepg.runner.compile_once`; in no experiment's time), or None if it did not."""
+    from safepg.thesis.prefetch import COMPILE_ONCE
+
+    return _timing_seconds(root / COMPILE_ONCE)
+
+
 def campaign(root: Path) -> list[Work]:
     """Every stored computation of the book's campaign, chapter by chapter."""
     out = [experiment_work(n, ch, root) for ch, names in CHAPTER_EXPERIMENTS.items() for n in names]

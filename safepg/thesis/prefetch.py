@@ -53,6 +53,8 @@ PLAIN_INTERVAL = 30.0
 #: Seconds between two redraws of a terminal's bar (its elapsed time and time left move).
 TTY_INTERVAL = 1.0
 PREFIX = "run-book"
+#: The store's folder of the time :func:`safepg.runner.compile_once` took (its ``timing.jsonl``).
+COMPILE_ONCE = "compile-once"
 
 
 @dataclass(frozen=True)
@@ -436,9 +438,12 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
             configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
                                                           for k in range(exp.seeds))]
     started = time.monotonic()
-    if runner.compile_once(configs, jobs):
-        _say(stream, "kernels compiled once, each task family in one worker, in "
-                     f"{_duration(time.monotonic() - started)}")
+    runs = runner.compile_once(configs, jobs)
+    if runs:
+        seconds = time.monotonic() - started
+        (root / COMPILE_ONCE).mkdir(parents=True, exist_ok=True)
+        runner.record_timing(root / COMPILE_ONCE, seconds, runs, jobs)  # benchmarks/bench_book.py reads it
+        _say(stream, f"kernels compiled once, each task family in one worker, in {_duration(seconds)}")
 
 
 def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream: TextIO | None = None,
