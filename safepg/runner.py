@@ -209,9 +209,12 @@ def _compute(cfg: RunConfig, seed: int, theta0: np.ndarray | None, single_thread
 
 
 def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
-                  single_thread: bool) -> tuple[int, LearningRecord]:
-    """:func:`_compute` tagged with the task's index: results arrive in any order."""
-    return i, _compute(cfg, seed, theta0, single_thread)
+                  single_thread: bool) -> tuple[int, LearningRecord, float]:
+    """:func:`_compute` tagged with the task's index (results arrive in any order), and the
+    seconds the run took on its worker."""
+    started = time.perf_counter()
+    rec = _compute(cfg, seed, theta0, single_thread)
+    return i, rec, time.perf_counter() - started
 
 
 def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
@@ -234,6 +237,17 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
     if damaged:
         raise DamagedRunsError(damaged)
     return out
+
+
+@dataclass(frozen=True)
+class RunGroup:
+    """The runs of one folder of the store: ``configs``, each for seeds ``0 .. seeds - 1``, the
+    warm-started ones from ``starts`` (by config name, seed by seed)."""
+
+    configs: Sequence[RunConfig]
+    seeds: int
+    folder: Path
+    starts: Mapping[str, Sequence[np.ndarray]] = field(default_factory=dict)
 
 
 def run_configs(
@@ -270,39 +284,62 @@ def run_configs(
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
     """
+    group = RunGroup(configs, seeds, Path(folder), starts or {})
+    return run_groups([group], jobs, progress, desc or Path(folder).name)[0]
+
+
+def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True,
+               desc: str | None = None) -> list[dict[str, list[LearningRecord]]]:
+    """:func:`run_configs` for several folders at once: their missing runs in one dispatch.
+
+    The runs of all the groups are dispatched longest first together, so that no worker waits
+    at the end of one group while another group has runs left. Each group's ``timing.jsonl``
+    gets its share of the dispatch's wall time, in proportion to its runs' time on the workers
+    (one group: the whole wall time). Returns each group's records by config name, in order.
+    """
     from joblib import Parallel, delayed, effective_n_jobs
 
-    folder = Path(folder)
     if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs == 0:
         raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
-    starts = starts or {}
-    for c in configs:
-        if c.warm_start is not None and len(starts.get(c.name, ())) < seeds:
-            raise ValueError(f"starts must give {seeds} starting points for the warm-started config {c.name!r}")
-    # Files a killed runner was writing; a live runner's are kept.
-    remove_stale_temp_files(folder)
-    todo = [(c, seed) for c in configs for seed in range(seeds) if stored_run(folder, c, seed, "set_aside") is None]
+    for g in groups:
+        for c in g.configs:
+            if c.warm_start is not None and len(g.starts.get(c.name, ())) < g.seeds:
+                raise ValueError(f"starts must give {g.seeds} starting points for the warm-started config {c.name!r}")
+    todo: list[tuple[int, RunConfig, int]] = []
+    for k, g in enumerate(groups):
+        # Files a killed runner was writing; a live runner's are kept.
+        remove_stale_temp_files(g.folder)
+        todo += [(k, c, seed) for c in g.configs for seed in range(g.seeds)
+                 if stored_run(g.folder, c, seed, "set_aside") is None]
     # Longest runs first, so that no long run is dispatched last and leaves the other workers
     # idle at the end: the largest budgets; among equal budgets the adaptive runs (a Python
     # iteration each, with the bound and the N* search: one seed of Table 5.3 takes about 12 s
     # adaptive, 9.5 s at N = 100 and 7.5 s at N = 1000), then the smallest fixed batch sizes
     # (more iterations). Stable: ties keep the given order.
-    todo.sort(key=lambda cs: (-cs[0].budget, isinstance(cs[0].method, Vanilla),
-                              cs[0].method.batch_size if isinstance(cs[0].method, Vanilla) else 0))
+    todo.sort(key=lambda kcs: (-kcs[1].budget, isinstance(kcs[1].method, Vanilla),
+                               kcs[1].method.batch_size if isinstance(kcs[1].method, Vanilla) else 0))
     if todo:
         started = time.perf_counter()
         n_jobs = effective_n_jobs(jobs)
-        tasks = (delayed(_compute_task)(i, c, seed, None if c.warm_start is None else starts[c.name][seed], n_jobs > 1)
-                 for i, (c, seed) in enumerate(todo))
-        with tqdm(total=len(todo), desc=desc or folder.name, unit="run", disable=not progress) as bar:
-            for i, rec in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+        tasks = (delayed(_compute_task)(i, c, seed, None if c.warm_start is None else groups[k].starts[c.name][seed],
+                                        n_jobs > 1)
+                 for i, (k, c, seed) in enumerate(todo))
+        worked = [0.0] * len(groups)
+        with tqdm(total=len(todo), desc=desc or groups[0].folder.name, unit="run", disable=not progress) as bar:
+            for i, rec, seconds in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
                 if rec.interrupted:  # Ctrl-C caught by a run in this process: stop the campaign
                     raise KeyboardInterrupt
-                c, seed = todo[i]
-                store_run(rec, folder, c, seed)
+                k, c, seed = todo[i]
+                store_run(rec, groups[k].folder, c, seed)
+                worked[k] += seconds
                 bar.update()
-        record_timing(folder, time.perf_counter() - started, len(todo), n_jobs)
-    return load_configs(configs, seeds, folder)
+        wall = time.perf_counter() - started
+        for k, g in enumerate(groups):
+            runs = sum(1 for kk, _, _ in todo if kk == k)
+            if runs:
+                share = worked[k] / sum(worked) if sum(worked) > 0 else runs / len(todo)
+                record_timing(g.folder, wall * share, runs, n_jobs)
+    return [load_configs(g.configs, g.seeds, g.folder) for g in groups]
 
 
 def _shape(d: Any) -> Any:
@@ -359,7 +396,8 @@ def compile_once(configs: Sequence[RunConfig], jobs: int = -1) -> int:
     return sum(Parallel(n_jobs=n_jobs)(delayed(_short_runs)(g) for g in groups))
 
 
-#: One line per call of :func:`run_configs` that computed runs in a folder: how long it took.
+#: One line per call of :func:`run_configs` (or :func:`run_groups`) that computed runs in a folder:
+#: how long it took (its share of the call's wall time).
 TIMING_FILE = "timing.jsonl"
 
 
@@ -372,5 +410,5 @@ def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
         f.write(line + "\n")
 
 
-__all__ = ["RESULTS_VERSION", "RunConfig", "TIMING_FILE", "compile_once", "load_configs", "make_env", "record_timing",
-           "run_configs", "run_path", "store_run", "stored_run"]
+__all__ = ["RESULTS_VERSION", "RunConfig", "RunGroup", "TIMING_FILE", "compile_once", "load_configs", "make_env",
+           "record_timing", "run_configs", "run_groups", "run_path", "store_run", "stored_run"]

@@ -193,6 +193,38 @@ def test_kernels_compile_once_for_what_is_left_to_compute(tmp_path, monkeypatch)
     assert compile_seconds(tmp_path) == json.loads(timing[0])["seconds"]
 
 
+def test_experiments_dispatched_together_store_what_each_alone_stores(tmp_path):
+    """Several experiments in one dispatch (a later one for an experiment that warm-starts from
+    another): the same run files as one experiment at a time, a line as each is done, and each
+    experiment's share of the time."""
+    tasks = [_small(), prefetch.Task("cartpole", "cartpole-baseline-authors", seeds=1),
+             prefetch.Task("cartpole", "table-5.4-authors", seeds=1, budget=20_000)]
+    out = io.StringIO()
+    got = prefetch.prefetch_experiments(tasks, tmp_path / "together", jobs=2, stream=out, tty=False)
+    assert got == dict.fromkeys(["table-5.1", "cartpole-baseline-authors", "table-5.4-authors"], "computed")
+    lines = out.getvalue().splitlines()
+    assert lines[0] == "run-book: 3 experiments: computing 27 of 27 runs (0 stored)"
+    for name, runs in (("table-5.1", 24), ("cartpole-baseline-authors", 1), ("table-5.4-authors", 2)):
+        assert sum(line.startswith(f"run-book: {name}: done, {runs}/{runs} runs, ") for line in lines) == 1, lines
+    assert lines[-1].startswith("run-book: 3 experiments: done, 27/27 runs, ")
+    for t in tasks:
+        prefetch.prefetch_experiment(t, tmp_path / "alone", jobs=1, stream=io.StringIO(), tty=False)
+    together = sorted((tmp_path / "together").rglob("*.npz"))
+    assert len(together) == 27
+    for path in together:
+        a, b = np.load(path), np.load(tmp_path / "alone" / path.relative_to(tmp_path / "together"))
+        assert a.files == b.files and all(a[k].tobytes() == b[k].tobytes() for k in a.files), path
+    shares = [json.loads(line)["seconds"] for t in tasks
+              for line in (tmp_path / "together" / t.name / "timing.jsonl").read_text().splitlines()]
+    assert len(shares) == 3 and all(s > 0 for s in shares)
+    again = io.StringIO()
+    assert set(prefetch.prefetch_experiments(tasks, tmp_path / "together", jobs=2, stream=again,
+                                             tty=False).values()) == {"stored"}
+    assert again.getvalue().splitlines() == ["run-book: table-5.1: stored (24 runs)",
+                                             "run-book: cartpole-baseline-authors: stored (1 runs)",
+                                             "run-book: table-5.4-authors: stored (2 runs)"]
+
+
 def test_an_interrupted_task_says_stopped(tmp_path, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

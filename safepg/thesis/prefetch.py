@@ -43,7 +43,7 @@ from tqdm import tqdm
 from safepg import runner
 from safepg.learning import LearningRecord
 from safepg.runner import RunConfig
-from safepg.thesis.experiment_store import experiment_folder, run_experiment
+from safepg.thesis.experiment_store import experiment_folder, run_experiment, run_experiments
 from safepg.thesis.experiments import EXPERIMENTS, get_experiment, scaled
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
@@ -285,6 +285,14 @@ class Progress:
             elif self.clock() - self.last_line >= self.interval and self.done < self.total:
                 self._line()
 
+    def note(self, text: str) -> None:
+        """One line about the task (above the bar on a terminal)."""
+        with self.lock:
+            if self.bar is not None:
+                self.bar.write(f"{PREFIX}: {text}", file=self.stream)
+            else:
+                self._print(text)
+
     def close(self, finished: bool = True) -> None:
         """Stop the redraws and say how it ended: ``done``, or ``stopped`` (an error, Ctrl-C)."""
         self._stop.set()
@@ -308,13 +316,16 @@ def previous_seconds(book: Path, name: str) -> float | None:
 
 
 @contextmanager
-def _reporting_stored_runs(progress: Progress) -> Iterator[None]:
-    """Tell ``progress`` of every run the runner stores (``run_configs`` stores each as it arrives)."""
+def _reporting_stored_runs(progress: Progress,
+                           counted: Callable[[LearningRecord, Path], bool] | None = None) -> Iterator[None]:
+    """Tell ``progress`` of every run the runner stores (``run_configs`` stores each as it arrives),
+    or of those for which ``counted(record, folder)`` is true."""
     store = runner.store_run
 
     def store_and_report(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
         store(rec, folder, cfg, seed)
-        progress.advance(int(np.sum(rec.batch_size)), float(cfg.budget))
+        if counted is None or counted(rec, Path(folder)):
+            progress.advance(int(np.sum(rec.batch_size)), float(cfg.budget))
 
     runner.store_run = store_and_report
     try:
@@ -353,6 +364,70 @@ def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO |
         raise
     progress.close()
     return "computed"
+
+
+def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: TextIO | None = None,
+                         tty: bool | None = None, interval: float | None = None,
+                         book: Path = BOOK) -> dict[str, str]:
+    """Compute the missing runs of several experiment tasks into ``root``, dispatched together
+    (:func:`safepg.thesis.experiment_store.run_experiments`); ``{name: "stored" | "computed"}``.
+
+    One progress bar (or plain lines) for all of them, and a line as each experiment is done.
+    A single experiment with runs to compute is :func:`prefetch_experiment`.
+    """
+    stream = stream or sys.stdout
+    done: dict[str, str] = {}
+    pending = []
+    for t in tasks:
+        exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
+        folder = experiment_folder(exp, root)
+        missing = [(c, k) for c in exp.configs for k in range(exp.seeds) if runner.stored_run(folder, c, k) is None]
+        if missing:
+            pending.append((t, exp, folder, missing))
+        else:
+            _say(stream, f"{exp.name}: stored ({len(exp.configs) * exp.seeds} runs)")
+            done[exp.name] = "stored"
+    if len(pending) == 1:
+        done[pending[0][0].name] = prefetch_experiment(pending[0][0], root, jobs, stream, tty, interval, book)
+    if len(pending) < 2:
+        return done
+    total = sum(len(exp.configs) * exp.seeds for _, exp, _, _ in pending)
+    work = float(sum(c.budget for *_, missing in pending for c, _ in missing))
+    previous: float | None = 0.0
+    for t, exp, _, missing in pending:
+        last = previous_seconds(book, exp.name) if t.budget is None else None
+        if last is None or previous is None:
+            previous = None
+            continue
+        whole = sum(c.budget for c in exp.configs) * exp.seeds
+        previous += last * sum(c.budget for c, _ in missing) / whole
+    name = f"{len(pending)} experiments"
+    progress = Progress(name, total, total - sum(len(m) for *_, m in pending), work, stream=stream, tty=tty,
+                        interval=interval, previous_s=previous)
+    names = {folder: exp.name for _, exp, folder, _ in pending}
+    runs = {folder: len(missing) for *_, folder, missing in pending}
+    left, trajectories = dict(runs), dict.fromkeys(runs, 0)
+
+    def stored(rec: LearningRecord, folder: Path) -> bool:
+        """Count a run of the experiments (not of one they start from, run at its own budget)."""
+        if left.get(folder, 0) == 0:
+            return False
+        left[folder] -= 1
+        trajectories[folder] += int(np.sum(rec.batch_size))
+        if left[folder] == 0:
+            progress.note(f"{names[folder]}: done, {runs[folder]}/{runs[folder]} runs, "
+                          f"{trajectories[folder]:.3g} trajectories, at {_duration(progress.elapsed())}")
+        return True
+
+    try:
+        with _reporting_stored_runs(progress, stored):
+            run_experiments([exp for _, exp, _, _ in pending], jobs=jobs, root=root, progress=False)
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
+    done.update({exp.name: "computed" for _, exp, _, _ in pending})
+    return done
 
 
 def _sweep_path(root: Path, seeds: int = 1, budget: int = 1_000_000) -> Path:
@@ -437,12 +512,15 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
             # A file's presence is enough here (a stale or damaged one is recomputed all the same).
             configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
                                                           for k in range(exp.seeds))]
+    from joblib import effective_n_jobs
+
     started = time.monotonic()
     runs = runner.compile_once(configs, jobs)
     if runs:
         seconds = time.monotonic() - started
         (root / COMPILE_ONCE).mkdir(parents=True, exist_ok=True)
-        runner.record_timing(root / COMPILE_ONCE, seconds, runs, jobs)  # benchmarks/bench_book.py reads it
+        # benchmarks/bench_book.py reads it
+        runner.record_timing(root / COMPILE_ONCE, seconds, runs, effective_n_jobs(jobs))
         _say(stream, f"kernels compiled once, each task family in one worker, in {_duration(seconds)}")
 
 
@@ -457,12 +535,13 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
     started = time.monotonic()
     _say(stream, f"{len(tasks)} computation{'s' * (len(tasks) != 1)} the chapters need, stored in {root}")
     _compile_once(tasks, root, jobs, stream)
-    done = {}
+    kw: dict[str, Any] = dict(stream=stream, tty=tty, interval=interval, book=book)
+    # The experiments first, together (no worker waits at the end of one), then the rest in order.
+    done = prefetch_experiments([t for t in tasks if t.kind == "experiment"], root, jobs=jobs, **kw)
     for t in tasks:
-        kw: dict[str, Any] = dict(stream=stream, tty=tty, interval=interval, book=book)
         if t.kind == "experiment":
-            done[t.name] = prefetch_experiment(t, root, jobs=jobs, **kw)
-        elif t.kind == "table-5.1-sweep":
+            continue
+        if t.kind == "table-5.1-sweep":
             done[t.name] = prefetch_sweep(t, root, **kw)
         else:
             done[t.name] = prefetch_safety(t, root, **kw)
