@@ -241,8 +241,8 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
 
 @dataclass(frozen=True)
 class RunGroup:
-    """The runs of one folder of the store: ``configs``, each for seeds ``0 .. seeds - 1``, the
-    warm-started ones from ``starts`` (by config name, seed by seed)."""
+    """The runs of one folder of the store: each of ``configs`` for ``seeds`` seeds (0, 1, ...),
+    the warm-started ones from ``starts`` (by config name, seed by seed)."""
 
     configs: Sequence[RunConfig]
     seeds: int
