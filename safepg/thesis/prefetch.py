@@ -504,6 +504,8 @@ def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: b
 
 def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
     """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute."""
+    from joblib import effective_n_jobs
+
     configs = []
     for t in tasks:
         if t.kind == "experiment":
@@ -512,8 +514,6 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
             # A file's presence is enough here (a stale or damaged one is recomputed all the same).
             configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
                                                           for k in range(exp.seeds))]
-    from joblib import effective_n_jobs
-
     started = time.monotonic()
     runs = runner.compile_once(configs, jobs)
     if runs:
