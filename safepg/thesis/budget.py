@@ -24,6 +24,7 @@ from safepg.runner import RESULTS_VERSION, TIMING_FILE
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiment_store import experiment_folder, load_experiment
 from safepg.thesis.experiments import get_experiment
+from safepg.thesis.prefetch import COMPILE_ONCE
 
 #: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
 CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
@@ -138,8 +139,6 @@ def safety_work(root: Path) -> list[Work]:
 def compile_seconds(root: Path) -> float | None:
     """The seconds ``run-book`` spent compiling the kernels once before its tasks
     (:func:`safepg.runner.compile_once`; in no experiment's time), or None if it did not."""
-    from safepg.thesis.prefetch import COMPILE_ONCE
-
     return _timing_seconds(root / COMPILE_ONCE)
 
 

@@ -44,7 +44,7 @@ from safepg import runner
 from safepg.learning import LearningRecord
 from safepg.runner import RunConfig
 from safepg.thesis.experiment_store import experiment_folder, run_experiment, run_experiments
-from safepg.thesis.experiments import EXPERIMENTS, get_experiment, scaled
+from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment, scaled
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
 BOOK = Path(__file__).resolve().parents[2] / "book"
@@ -339,23 +339,36 @@ def _say(stream: TextIO, text: str) -> None:
     print(f"{PREFIX}: {text}", file=stream, flush=True)
 
 
+def _missing_runs(task: Task, root: Path) -> tuple[Experiment, Path, list[tuple[RunConfig, int]]]:
+    """An experiment task's experiment (its seeds and budget applied), its folder under ``root``
+    and its (config, seed) pairs that are not stored."""
+    exp = scaled(get_experiment(task.name), seeds=task.seeds, budget=task.budget)
+    folder = experiment_folder(exp, root)
+    return exp, folder, [(c, k) for c in exp.configs for k in range(exp.seeds)
+                         if runner.stored_run(folder, c, k) is None]
+
+
+def _previous_share(task: Task, exp: Experiment, missing: list[tuple[RunConfig, int]], book: Path) -> float | None:
+    """The seconds the last measured build took for ``missing`` (its share of the experiment's
+    budget), or None if unknown or if the task has another budget."""
+    last = previous_seconds(book, exp.name) if task.budget is None else None
+    if last is None:
+        return None
+    return last * sum(c.budget for c, _ in missing) / (sum(c.budget for c in exp.configs) * exp.seeds)
+
+
 def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
                         tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
     """Compute the missing runs of an experiment task into ``root``; ``"stored"`` or ``"computed"``."""
     stream = stream or sys.stdout
-    exp = scaled(get_experiment(task.name), seeds=task.seeds, budget=task.budget)
-    folder = experiment_folder(exp, root)
-    missing = [(c, k) for c in exp.configs for k in range(exp.seeds) if runner.stored_run(folder, c, k) is None]
+    exp, _, missing = _missing_runs(task, root)
     total = len(exp.configs) * exp.seeds
     if not missing:
         _say(stream, f"{exp.name}: stored ({total} runs)")
         return "stored"
     work = float(sum(c.budget for c, _ in missing))
-    previous = previous_seconds(book, exp.name) if task.budget is None else None
-    if previous is not None:
-        previous *= work / sum(c.budget for c in exp.configs for _ in range(exp.seeds))
     progress = Progress(exp.name, total, total - len(missing), work, stream=stream, tty=tty, interval=interval,
-                        previous_s=previous)
+                        previous_s=_previous_share(task, exp, missing, book))
     try:
         with _reporting_stored_runs(progress):
             run_experiment(exp, jobs=jobs, root=root, progress=False)
@@ -379,9 +392,7 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
     done: dict[str, str] = {}
     pending = []
     for t in tasks:
-        exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
-        folder = experiment_folder(exp, root)
-        missing = [(c, k) for c in exp.configs for k in range(exp.seeds) if runner.stored_run(folder, c, k) is None]
+        exp, folder, missing = _missing_runs(t, root)
         if missing:
             pending.append((t, exp, folder, missing))
         else:
@@ -393,14 +404,8 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
         return done
     total = sum(len(exp.configs) * exp.seeds for _, exp, _, _ in pending)
     work = float(sum(c.budget for *_, missing in pending for c, _ in missing))
-    previous: float | None = 0.0
-    for t, exp, _, missing in pending:
-        last = previous_seconds(book, exp.name) if t.budget is None else None
-        if last is None or previous is None:
-            previous = None
-            continue
-        whole = sum(c.budget for c in exp.configs) * exp.seeds
-        previous += last * sum(c.budget for c, _ in missing) / whole
+    shares = [_previous_share(t, exp, missing, book) for t, exp, _, missing in pending]
+    previous = None if None in shares else sum(s for s in shares if s is not None)
     name = f"{len(pending)} experiments"
     progress = Progress(name, total, total - sum(len(m) for *_, m in pending), work, stream=stream, tty=tty,
                         interval=interval, previous_s=previous)
