@@ -183,6 +183,14 @@ def _experiment_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]
     p.add_argument("--jobs", type=jobs_integer, default=-1, help="parallel workers, as the notebooks: all cores")
     p.add_argument("--list", action="store_true", help="only list what the chapters need")
     p.set_defaults(func=_cmd_run_book)
+    p = sub.add_parser("two-draws", help="run the scorecard's campaign again on seeds disjoint from the book's and "
+                                         "print every row's status under both draws")
+    p.add_argument("--root", default="results-draw-2",
+                   help="the second draw's results folder (default: results-draw-2); the first draw is "
+                        "$SAFEPG_RESULTS or results/")
+    p.add_argument("--jobs", type=jobs_integer, default=-1, help="parallel workers; -1 (default) all cores")
+    p.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    p.set_defaults(func=_cmd_two_draws)
 
 
 def _run_command(args: argparse.Namespace) -> str:
@@ -218,6 +226,28 @@ def _cmd_run_book(args: argparse.Namespace) -> None:
             print(f"{t.chapter:12s} {t.name}" + (f" ({t.seeds} seeds)" if t.seeds else ""))
         return
     prefetch.prefetch(book, Path(args.root) if args.root else None, jobs=args.jobs)
+
+
+def _cmd_two_draws(args: argparse.Namespace) -> dict[str, Any] | None:
+    import time
+    from pathlib import Path
+
+    from safepg.thesis import draws
+    from safepg.thesis.scorecard.rows import build_rows
+
+    started = time.monotonic()
+    draws.run_draw(Path(args.root), jobs=args.jobs)
+    seconds = time.monotonic() - started
+    c = draws.compare_draws(build_rows(results_dir()), build_rows(Path(args.root)))
+    if args.json:
+        return {"seconds": seconds, "rows": [{"id": a.id, "draw_1": a.status, "draw_2": b.status,
+                                              "p_1": [a.p_value, a.authors_p_value],
+                                              "p_2": [b.p_value, b.authors_p_value]} for a, b in c.rows],
+                "changed": [a.id for a, _ in c.changed], "flips": [a.id for a, _ in c.flips],
+                "inconclusive": list(c.inconclusive)}
+    print(draws.comparison_text(c))
+    print(f"two-draws: the second draw and its seed rule in {seconds:.0f} s")
+    return None
 
 
 def _cmd_report(args: argparse.Namespace) -> dict[str, Any] | None:

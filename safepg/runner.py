@@ -217,9 +217,25 @@ def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
     return i, rec, time.perf_counter() - started
 
 
-def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
-                 on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``configs`` by config name (missing seeds are left out).
+#: Seeds per configuration: one count for all, or a count by config name.
+Seeds = int | Mapping[str, int]
+
+
+def seeds_of(seeds: Seeds, name: str) -> int:
+    """How many seeds config ``name`` runs under ``seeds`` (one count for all, or by config name).
+
+    Raises
+    ------
+    KeyError
+        If ``seeds`` is a mapping without ``name``.
+    """
+    return int(seeds) if isinstance(seeds, int | np.integer) else int(seeds[name])
+
+
+def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.PathLike[str],
+                 on_damaged: OnDamaged = "warn", first_seed: int = 0) -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``configs`` by config name (missing seeds are left out): seeds
+    ``first_seed .. first_seed + n - 1``, n the config's count in ``seeds``.
 
     Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
     read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
@@ -228,7 +244,7 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
     damaged = []
     for c in configs:
         recs = []
-        for seed in range(seeds):
+        for seed in range(first_seed, first_seed + seeds_of(seeds, c.name)):
             try:
                 recs.append(stored_run(folder, c, seed, on_damaged))
             except DamagedRunsError as err:
@@ -241,23 +257,30 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
 
 @dataclass(frozen=True)
 class RunGroup:
-    """The runs of one folder of the store: each of ``configs`` for ``seeds`` seeds (0, 1, ...),
-    the warm-started ones from ``starts`` (by config name, seed by seed)."""
+    """The runs of one folder of the store: each of ``configs`` for its count of ``seeds`` (one count
+    for all, or by config name), seeds ``first_seed``, ``first_seed + 1``, ...; the warm-started ones
+    from ``starts`` (by config name, one per seed in that order)."""
 
     configs: Sequence[RunConfig]
-    seeds: int
+    seeds: Seeds
     folder: Path
     starts: Mapping[str, Sequence[np.ndarray]] = field(default_factory=dict)
+    first_seed: int = 0
+
+    def seed_range(self, config: RunConfig) -> range:
+        """The seeds of ``config`` in this group."""
+        return range(self.first_seed, self.first_seed + seeds_of(self.seeds, config.name))
 
 
 def run_configs(
     configs: Sequence[RunConfig],
-    seeds: int,
+    seeds: Seeds,
     folder: str | os.PathLike[str],
     starts: Mapping[str, Sequence[np.ndarray]] | None = None,
     jobs: int = -1,
     progress: bool = True,
     desc: str | None = None,
+    first_seed: int = 0,
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) and return all records by config name.
 
@@ -272,9 +295,9 @@ def run_configs(
     Parameters
     ----------
     configs
-        The configurations, each run for seeds ``0 .. seeds - 1``.
+        The configurations, each run for seeds ``first_seed .. first_seed + n - 1``.
     seeds
-        Number of seeds.
+        Number of seeds n: one for all configs, or a count by config name.
     folder
         The group's folder in the store; seed k of config ``c`` is ``folder/c.name/seed-k.npz``.
     starts
@@ -283,8 +306,10 @@ def run_configs(
         joblib's ``n_jobs``: a positive count, or -1 for every core (-2 all but one, ...).
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
+    first_seed
+        The first seed's index (another draw of the same runs: seeds disjoint from 0, 1, ...).
     """
-    group = RunGroup(configs, seeds, Path(folder), starts or {})
+    group = RunGroup(configs, seeds, Path(folder), starts or {}, first_seed)
     return run_groups([group], jobs, progress, desc or Path(folder).name)[0]
 
 
@@ -303,13 +328,14 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
         raise ValueError(f"jobs must be a positive number of workers or negative (-1: all cores), got {jobs!r}")
     for g in groups:
         for c in g.configs:
-            if c.warm_start is not None and len(g.starts.get(c.name, ())) < g.seeds:
-                raise ValueError(f"starts must give {g.seeds} starting points for the warm-started config {c.name!r}")
+            if c.warm_start is not None and len(g.starts.get(c.name, ())) < len(g.seed_range(c)):
+                raise ValueError(f"starts must give {len(g.seed_range(c))} starting points for the warm-started "
+                                 f"config {c.name!r}")
     todo: list[tuple[int, RunConfig, int]] = []
     for k, g in enumerate(groups):
         # Files a killed runner was writing; a live runner's are kept.
         remove_stale_temp_files(g.folder)
-        todo += [(k, c, seed) for c in g.configs for seed in range(g.seeds)
+        todo += [(k, c, seed) for c in g.configs for seed in g.seed_range(c)
                  if stored_run(g.folder, c, seed, "set_aside") is None]
     # Longest runs first, so that no long run is dispatched last and leaves the other workers
     # idle at the end: the largest budgets; among equal budgets the adaptive runs (a Python
@@ -321,8 +347,8 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
     if todo:
         started = time.perf_counter()
         n_jobs = effective_n_jobs(jobs)
-        tasks = (delayed(_compute_task)(i, c, seed, None if c.warm_start is None else groups[k].starts[c.name][seed],
-                                        n_jobs > 1)
+        tasks = (delayed(_compute_task)(i, c, seed, None if c.warm_start is None else
+                                        groups[k].starts[c.name][seed - groups[k].first_seed], n_jobs > 1)
                  for i, (k, c, seed) in enumerate(todo))
         worked = [0.0] * len(groups)
         with tqdm(total=len(todo), desc=desc or groups[0].folder.name, unit="run", disable=not progress) as bar:
@@ -339,7 +365,7 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
             if runs:
                 share = worked[k] / sum(worked) if sum(worked) > 0 else runs / len(todo)
                 record_timing(g.folder, wall * share, runs, n_jobs)
-    return [load_configs(g.configs, g.seeds, g.folder) for g in groups]
+    return [load_configs(g.configs, g.seeds, g.folder, first_seed=g.first_seed) for g in groups]
 
 
 def _shape(d: Any) -> Any:
@@ -410,5 +436,5 @@ def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
         f.write(line + "\n")
 
 
-__all__ = ["RESULTS_VERSION", "RunConfig", "RunGroup", "TIMING_FILE", "compile_once", "load_configs", "make_env",
-           "record_timing", "run_configs", "run_groups", "run_path", "store_run", "stored_run"]
+__all__ = ["RESULTS_VERSION", "RunConfig", "RunGroup", "Seeds", "TIMING_FILE", "compile_once", "load_configs",
+           "make_env", "record_timing", "run_configs", "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]

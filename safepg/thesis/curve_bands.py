@@ -33,21 +33,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, NamedTuple
 
 import numpy as np
 
 from safepg.learning import LearningRecord
 from safepg.options import Adaptive
+from safepg.significance import CurvePredictionTest, PermutationTest, block_means
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, overlays
 from safepg.thesis.analysis import by_iteration
 from safepg.thesis.authors import TABLE_5_4_BUDGET, AuthorsRun
 from safepg.thesis.experiments import get_experiment, method_of
 
-#: The scorecard's rule: a curve is reproduced when at least this share of it lies in our band.
+#: The share of a curve inside our band that the scorecard once took for "reproduced"; the share is now a
+#: description (where the curves part), and the curve's test decides (:attr:`CurveScore.test`).
 CURVE_SHARE = 0.9
+#: A curve is tested as its means over this many equal blocks of the plotted range (early, middle, late).
+CURVE_BLOCKS = 3
+#: The share of the authors' values' range that matters for a curve (the scorecard's relevance).
+CURVE_RELEVANT_SHARE = 0.05
 #: The experiments whose runs the scored figures draw (load these for :func:`curve_scores`).
 CURVE_EXPERIMENTS = ("table-5.2", "figures-5.1-5.2-authors", "table-5.2-authors", "figures-5.5-5.6", "table-5.3",
                      "table-5.3-authors", "table-5.4", "table-5.4-authors-theta-star")
@@ -101,6 +107,16 @@ class CurveScore:
     processing : str
         How their curve and ours were made from runs: ``"text"`` (as the thesis says; every figure) or
         ``"authors"`` (their plot script's, Figures 5.1, 5.2 and 5.5: :func:`~safepg.thesis.authors.grid_curve`).
+    test : safepg.significance.PermutationTest or safepg.significance.CurvePredictionTest or None
+        Their runs of the curve (or their one run) against ours, as block means (:func:`curve_test`); None
+        where fewer than two of our runs cover the plotted range.
+    relevance : float
+        The difference that matters: :data:`CURVE_RELEVANT_SHARE` of the range of the authors' values over
+        every curve of the figure (:func:`curve_scores`; :attr:`y_range` for this curve alone).
+    x_range : (float, float)
+        The range the test covers: where their runs and all of ours have values.
+    y_range : (float, float)
+        The least and the largest of their values there.
     """
 
     figure: str
@@ -117,6 +133,10 @@ class CurveScore:
     outside: tuple[tuple[float, float, float, float], ...]
     x_unit: str
     processing: str = "text"
+    test: Any = None
+    relevance: float = math.nan
+    x_range: tuple[float, float] = (math.nan, math.nan)
+    y_range: tuple[float, float] = (math.nan, math.nan)
 
 
 # ------------------------------------------------------------------ scoring one curve
@@ -207,13 +227,55 @@ def _kind(runs: int) -> str:
     return "one run" if runs == 1 else f"mean of {runs} runs"
 
 
+def curve_test(x: np.ndarray, theirs: np.ndarray, ours: np.ndarray, x_max: float | None = None
+               ) -> tuple[PermutationTest | CurvePredictionTest | None, tuple[float, float], tuple[float, float]]:
+    """Their runs of a curve against ours, each as its means over :data:`CURVE_BLOCKS` equal blocks of the
+    range where every curve has a value (up to ``x_max``): the two-sample permutation test for several runs
+    of theirs, Hotelling's test for one new curve for one.
+
+    Parameters
+    ----------
+    x : array_like, shape (P,)
+    theirs : array_like, shape (m, P) or (P,)
+        Their runs (one run: 1-D).
+    ours : array_like, shape (k, P)
+    x_max : float, optional
+        The figure's right end.
+
+    Returns
+    -------
+    test, y_range, x_range
+        The test (None with fewer than two of our runs there), the least and largest of their values there,
+        and that range of x.
+    """
+    x = np.asarray(x, dtype=float)
+    a = np.atleast_2d(np.asarray(theirs, dtype=float))
+    o = np.asarray(ours, dtype=float)
+    common = np.all(np.isfinite(a), axis=0) & np.all(np.isfinite(o), axis=0)
+    if x_max is not None:
+        common &= x <= x_max
+    if o.shape[0] < 2 or np.count_nonzero(common) < CURVE_BLOCKS:
+        return None, (math.nan, math.nan), (math.nan, math.nan)
+    xs, a, o = x[common], a[:, common], o[:, common]
+    x_range = (float(xs.min()), float(xs.max()))
+    a_blocks, o_blocks = block_means(xs, a, CURVE_BLOCKS, x_range), block_means(xs, o, CURVE_BLOCKS, x_range)
+    test = PermutationTest(a_blocks, o_blocks) if a.shape[0] > 1 else CurvePredictionTest(a_blocks[0], o_blocks)
+    return test, (float(np.min(a)), float(np.max(a))), x_range
+
+
 def _score(figure: str, curve: str, quantity: str, where: str, source: str, experiment: str, runs: int,
            x_unit: str, x: np.ndarray, theirs: np.ndarray, ours: np.ndarray, x_max: float | None = None,
-           rounding: np.ndarray | float | None = None, processing: str = "text") -> CurveScore:
+           rounding: np.ndarray | float | None = None, processing: str = "text",
+           their_runs: np.ndarray | None = None) -> CurveScore:
+    """A curve's score: its share inside our band (``theirs``, the plotted curve, against the band for
+    ``runs`` runs) and its test (:func:`curve_test`: ``their_runs`` where their history holds several
+    runs, else ``theirs``)."""
     rounding = written_rounding(theirs, digits=RUN_DIGITS) if rounding is None else rounding
     s = band_share(x, theirs, ours, runs, x_max, rounding)
+    test, y_range, x_range = curve_test(x, theirs if their_runs is None else their_runs, ours, x_max)
     return CurveScore(figure, curve, quantity, where, source, experiment, _kind(runs), s["seeds"], s["points"],
-                      s["without_band"], s["share_inside"], s["outside"], x_unit, processing)
+                      s["without_band"], s["share_inside"], s["outside"], x_unit, processing, test, math.nan,
+                      x_range, y_range)
 
 
 def _pad(theirs: np.ndarray, ours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -262,7 +324,31 @@ def figures51_52_score(records: Mapping[str, Sequence[LearningRecord]], cfg: Any
     return _score(figure, cfg.name, FIGURES_51_52_QUANTITY[processing], where,
                   _source(authors.figure51_52_curves()[key]), experiment, s["runs"], "trajectories", s["x"],
                   s["authors"], s["values"], rounding=written_rounding(s["authors"], decimals=CURVE_DECIMALS),
-                  processing=processing)
+                  processing=processing, their_runs=figures51_52_their_runs(key, s["x"], processing))
+
+
+def figures51_52_their_runs(key: tuple[str, str, bool, float], grid: np.ndarray,
+                            processing: overlays.Processing) -> np.ndarray:
+    """Each of the authors' committed runs of a Table 5.2 row (:func:`~safepg.thesis.authors.table52_runs`:
+    five, one for Bernstein e.r.) on the grid of Figures 5.1-5.2, processed as ``processing`` says: ``"text"``,
+    the J of the policy that collected trajectory T (as :func:`~safepg.record.on_trajectories` maps ours);
+    ``"authors"``, their ``scaleData.m`` (:func:`~safepg.thesis.authors.grid_curve`). Shape (runs, points),
+    NaN past a run's last trajectory."""
+    grid = np.asarray(grid)
+    out = []
+    for run in authors.table52_runs()[key]:
+        if processing == "authors":
+            x, z = authors.grid_curve(run["N"], run["J"])
+            if not np.array_equal(x, grid):
+                raise ValueError(f"{key}: the grid is not grid_curve's")
+            out.append(np.asarray(z, dtype=float))
+            continue
+        idx = np.searchsorted(np.cumsum(np.asarray(run["N"], dtype=np.int64)), grid)
+        row = np.full(grid.size, np.nan)
+        ok = idx < run.iterations
+        row[ok] = np.asarray(run["J"], dtype=float)[idx[ok]]
+        out.append(row)
+    return np.array(out)
 
 
 class Hypothesis(NamedTuple):
@@ -365,13 +451,31 @@ def _lqg1d_scores(records: Records) -> list[CurveScore]:
             continue
         key = (estimator, error.bound, error.empirical_range, error.delta)
         figure, where = ("5.3", "Figures 5.3 and 5.4") if error.bound == "chebyshev" else ("5.4", "Figure 5.4")
-        ours = by_iteration(recs[cfg.name], "batch_size")
-        for run in runs52.get(key, []):
-            theirs_n, mine_n = _pad(np.asarray(run["N"], dtype=float), ours)
-            scores.append(_score(figure, f"{cfg.name}/run-{run.key['run']}", "batch size N per iteration", where,
-                                 _source(run), exp.name, 1, "iterations", np.arange(1, theirs_n.size + 1), theirs_n,
-                                 mine_n))
+        sides: list[tuple[str, Sequence[LearningRecord]]] = [(exp.name, recs[cfg.name])]
+        sides += [] if theirs is None else [theirs]
+        for name, side in sides:
+            scores += _batch_size_scores(figure, where, cfg.name, name, runs52.get(key, []), side)
     return scores
+
+
+def _batch_size_scores(figure: str, where: str, curve: str, experiment: str, theirs_runs: Sequence[AuthorsRun],
+                       recs: Sequence[LearningRecord]) -> list[CurveScore]:
+    """Figures 5.3-5.4: each of the authors' runs' batch sizes per iteration against our runs of ``experiment``
+    (its own share of the band), all their runs at once in the curve's test."""
+    ours = by_iteration(recs, "batch_size")
+    length = max([ours.shape[1]] + [r.iterations for r in theirs_runs])
+    matrix = np.full((len(theirs_runs), length), np.nan)
+    for i, run in enumerate(theirs_runs):
+        matrix[i, : run.iterations] = np.asarray(run["N"], dtype=float)
+    _, mine_all = _pad(matrix[0], ours)
+    test, y_range, x_range = curve_test(np.arange(1, length + 1), matrix, mine_all)
+    out = []
+    for run in theirs_runs:
+        theirs_n, mine_n = _pad(np.asarray(run["N"], dtype=float), ours)
+        one = _score(figure, f"{curve}/run-{run.key['run']}", "batch size N per iteration", where, _source(run),
+                     experiment, 1, "iterations", np.arange(1, theirs_n.size + 1), theirs_n, mine_n)
+        out.append(replace(one, test=test, y_range=y_range, x_range=x_range))
+    return out
 
 
 def _held_score(figure: str, curve: str, quantity: str, experiment: str, run: AuthorsRun,
@@ -499,6 +603,14 @@ def curve_scores(records: Records) -> list[CurveScore]:
     list of CurveScore
     """
     scores = _lqg1d_scores(records) + _lqg2d_scores(records) + _cartpole_scores(records)
+    # The figure's scale: the range of the authors' values over all its curves, as its y-axis spans them.
+    spans: dict[str, tuple[float, float]] = {}
+    for sc in scores:
+        lo, hi = spans.get(sc.figure, (math.inf, -math.inf))
+        if all(math.isfinite(v) for v in sc.y_range):
+            spans[sc.figure] = (min(lo, sc.y_range[0]), max(hi, sc.y_range[1]))
+    scores = [replace(sc, relevance=CURVE_RELEVANT_SHARE * (spans[sc.figure][1] - spans[sc.figure][0]))
+              if sc.figure in spans else sc for sc in scores]
     return sorted(scores, key=lambda s: tuple(int(p) for p in s.figure.split(".")))
 
 

@@ -35,7 +35,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, cast
 
 import numpy as np
 from tqdm import tqdm
@@ -43,7 +43,7 @@ from tqdm import tqdm
 from safepg import runner
 from safepg.learning import LearningRecord
 from safepg.runner import RunConfig
-from safepg.thesis.experiment_store import experiment_folder, run_experiment, run_experiments
+from safepg.thesis.experiment_store import experiment_folder, read_campaign, run_experiment, run_experiments
 from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment, scaled
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
@@ -339,13 +339,26 @@ def _say(stream: TextIO, text: str) -> None:
     print(f"{PREFIX}: {text}", file=stream, flush=True)
 
 
+def _seeds(task: Task, exp: Experiment, root: Path) -> dict[str, range]:
+    """Each config's seeds for an experiment task: the task's count, else the folder's campaign's."""
+    campaign = read_campaign(root)
+    counts = campaign.counts(exp) if task.seeds is None else {c.name: task.seeds for c in exp.configs}
+    return {name: range(campaign.first_seed, campaign.first_seed + n) for name, n in counts.items()}
+
+
 def _missing_runs(task: Task, root: Path) -> tuple[Experiment, Path, list[tuple[RunConfig, int]]]:
     """An experiment task's experiment (its seeds and budget applied), its folder under ``root``
     and its (config, seed) pairs that are not stored."""
     exp = scaled(get_experiment(task.name), seeds=task.seeds, budget=task.budget)
     folder = experiment_folder(exp, root)
-    return exp, folder, [(c, k) for c in exp.configs for k in range(exp.seeds)
+    seeds = _seeds(task, exp, root)
+    return exp, folder, [(c, k) for c in exp.configs for k in seeds[c.name]
                          if runner.stored_run(folder, c, k) is None]
+
+
+def _total(task: Task, exp: Experiment, root: Path) -> int:
+    """An experiment task's runs in all."""
+    return sum(len(r) for r in _seeds(task, exp, root).values())
 
 
 def _previous_share(task: Task, exp: Experiment, missing: list[tuple[RunConfig, int]], book: Path) -> float | None:
@@ -357,12 +370,13 @@ def _previous_share(task: Task, exp: Experiment, missing: list[tuple[RunConfig, 
     return last * sum(c.budget for c, _ in missing) / (sum(c.budget for c in exp.configs) * exp.seeds)
 
 
+
 def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
                         tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
     """Compute the missing runs of an experiment task into ``root``; ``"stored"`` or ``"computed"``."""
     stream = stream or sys.stdout
     exp, _, missing = _missing_runs(task, root)
-    total = len(exp.configs) * exp.seeds
+    total = _total(task, exp, root)
     if not missing:
         _say(stream, f"{exp.name}: stored ({total} runs)")
         return "stored"
@@ -396,13 +410,13 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
         if missing:
             pending.append((t, exp, folder, missing))
         else:
-            _say(stream, f"{exp.name}: stored ({len(exp.configs) * exp.seeds} runs)")
+            _say(stream, f"{exp.name}: stored ({_total(t, exp, root)} runs)")
             done[exp.name] = "stored"
     if len(pending) == 1:
         done[pending[0][0].name] = prefetch_experiment(pending[0][0], root, jobs, stream, tty, interval, book)
     if len(pending) < 2:
         return done
-    total = sum(len(exp.configs) * exp.seeds for _, exp, _, _ in pending)
+    total = sum(_total(t, exp, root) for t, exp, _, _ in pending)
     work = float(sum(c.budget for *_, missing in pending for c, _ in missing))
     shares = [_previous_share(t, exp, missing, book) for t, exp, _, missing in pending]
     previous = None if None in shares else sum(s for s in shares if s is not None)
@@ -517,8 +531,9 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
             exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
             folder = experiment_folder(exp, root)
             # A file's presence is enough here (a stale or damaged one is recomputed all the same).
+            seeds = _seeds(t, exp, root)
             configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
-                                                          for k in range(exp.seeds))]
+                                                          for k in seeds[c.name])]
     started = time.monotonic()
     runs = runner.compile_once(configs, jobs)
     if runs:
@@ -527,6 +542,49 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
         # benchmarks/bench_book.py reads it
         runner.record_timing(root / COMPILE_ONCE, seconds, runs, effective_n_jobs(jobs))
         _say(stream, f"kernels compiled once, each task family in one worker, in {_duration(seconds)}")
+
+
+def _scorecard_tasks(tasks: list[Task]) -> bool:
+    """The tasks hold every experiment the scorecard reads, at their own seeds and budgets: the seed rule
+    applies to them."""
+    from safepg.thesis.scorecard.rows import AUTHORS_VARIANTS, NEEDED, RANGE_VARIANTS
+
+    full = {t.name for t in tasks if t.seeds is None and t.budget is None}
+    return set(NEEDED + RANGE_VARIANTS + AUTHORS_VARIANTS) <= full
+
+
+def _apply_seed_rule(root: Path, jobs: int, book: Path, kw: dict[str, Any]) -> None:
+    """:func:`safepg.thesis.seed_rule.plan_seeds` on the scorecard's rows, its runs computed like the
+    chapters' experiments (progress, a line as each is done)."""
+    from safepg.thesis.scorecard.rows import build_rows
+    from safepg.thesis.seed_rule import plan_seeds
+
+    stream = kw["stream"]
+    started = time.monotonic()
+
+    def run(names: list[str], folder: Path, n: int) -> None:
+        prefetch_experiments([Task("scorecard", name) for name in names], folder, jobs=n, **kw)
+
+    campaign = plan_seeds(root, lambda folder: build_rows(folder, book), jobs, run=run,
+                          stream=cast(TextIO, _Prefixed(stream)))
+    _say(stream, f"seed rule: {len(campaign.seeds)} configurations beyond their experiment's seeds, in "
+                 f"{_duration(time.monotonic() - started)}")
+
+
+class _Prefixed:
+    """A text stream that writes each line with :data:`PREFIX`."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+
+    def write(self, text: str) -> int:
+        body = text.rstrip("\n")
+        if body:
+            _say(self.stream, body)
+        return len(text)
+
+    def flush(self) -> None:
+        self.stream.flush()
 
 
 def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream: TextIO | None = None,
@@ -542,7 +600,10 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
     _compile_once(tasks, root, jobs, stream)
     kw: dict[str, Any] = dict(stream=stream, tty=tty, interval=interval, book=book)
     # The experiments first, together (no worker waits at the end of one), then the rest in order.
-    done = prefetch_experiments([t for t in tasks if t.kind == "experiment"], root, jobs=jobs, **kw)
+    experiments = [t for t in tasks if t.kind == "experiment"]
+    done = prefetch_experiments(experiments, root, jobs=jobs, **kw)
+    if _scorecard_tasks(experiments):
+        _apply_seed_rule(root, jobs, book, kw)
     for t in tasks:
         if t.kind == "experiment":
             continue

@@ -67,10 +67,13 @@ def report(exp: Experiment | str, records: dict[str, list[LearningRecord]] | Non
         # Components of theta that any seed's run changed (the thesis's remarks on which
         # entries the coordinate step leaves alone).
         updated = sorted({int(i) for r in recs for i in np.flatnonzero(r.theta[-1] != r.theta[0])})
+        upsilon, ratio = ([float(_summary(exp, c, r)[i]) for r in recs] for i in (0, 1))
         rows.append({
             "name": c.name, "method": to_dict(c.method), "sigma": c.sigma, "budget": c.budget, "seeds": len(recs),
-            "upsilon_bar": seed_summary95(_summary(exp, c, r)[0] for r in recs),
-            "improvement_ratio": seed_summary95(_summary(exp, c, r)[1] for r in recs),
+            # Each seed's value beside the summary: the scorecard's tests take the runs themselves.
+            "upsilon_bar": {**seed_summary95(upsilon), "values": upsilon},
+            "improvement_ratio": {**seed_summary95(ratio), "values": ratio},
+            "updates": [int(r.iterations) - 1 for r in recs],
             "theta_moved": max((float(np.max(np.abs(r.theta_final - r.theta[0]))) for r in recs), default=None),
             "improvement_ratio_on": exp.performance,
             "rules": exp.rules,

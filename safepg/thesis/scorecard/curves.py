@@ -13,7 +13,6 @@ from typing import Any
 
 from safepg.learning import LearningRecord
 from safepg.thesis.curve_bands import (
-    CURVE_SHARE,
     FIGURES_51_52_HYPOTHESES,
     CurveScore,
     curve_holds,
@@ -25,9 +24,11 @@ from safepg.thesis.curve_bands import (
 )
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.outputs import Output
+from safepg.thesis.scorecard.verdicts import relevance_text
 
 #: Experiments under the authors' settings: a curve scored on one of them fills the row's authors' column.
-AUTHORS_SETTINGS = ("table-5.3-authors", "table-5.4-authors-theta-star")
+AUTHORS_SETTINGS = ("table-5.3-authors", "table-5.4-authors-theta-star", "figures-5.1-5.2-authors",
+                    "table-5.2-authors")
 #: Where each figure is discussed: its group on the scorecard, the book's page and heading.
 FIGURE_PLACES = {"5.1": ("Section 5.1", "lqg1d", "Figures 5.1 and 5.2"),
                  "5.2": ("Section 5.1", "lqg1d", "Figures 5.1 and 5.2"),
@@ -95,8 +96,8 @@ def _column(scores: Sequence[CurveScore]) -> dict[str, Any]:
         text = f"{min(shares):.1%} to {max(shares):.1%} inside, each of their {len(scores)} runs"
     kind = worst.kind if worst.kind == "one run" else f"a {worst.kind}"
     return {"text": text, "share": min(shares), "holds": all(curve_holds(s) for s in scores), "seeds": worst.seeds,
-            "band": f"our pointwise 95% prediction band for {kind}, {worst.seeds} seeds; the rule: at least "
-                    f"{CURVE_SHARE:.0%} of the curve inside", "worst": worst}
+            "band": f"our pointwise 95% prediction band for {kind}, {worst.seeds} seeds (a description: the test "
+                    "decides)", "worst": worst, "test": scores[0].test, "relevance": scores[0].relevance}
 
 
 def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningRecord]]]) -> None:
@@ -124,7 +125,8 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
             raise TypeError(f"figure {figure}, {curve}: no column to show")
         first = shown["worst"]
         authors = AuthorsColumn() if theirs is None else AuthorsColumn(
-            text=theirs["text"], value=theirs["share"], ok=theirs["holds"], seeds=theirs["seeds"],
+            text=theirs["text"], value=theirs["share"], test=theirs["test"], seeds=theirs["seeds"],
+            sources=(f"{theirs['worst'].experiment}/{curve}",),
             experiment=theirs["worst"].experiment, interval_text=theirs["band"], note=AUTHORS_NOTES.get(figure, ""))
         processed = theirs is not None and theirs["worst"].processing == "authors"
         label = "Under the authors' processing and settings, ours" if processed else "Under the authors' settings, ours"
@@ -132,6 +134,7 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
                           for lab, c in (("Ours", ours), (label, theirs))
                           if c is not None and not c["holds"])
         still_open = not any(c is not None and c["holds"] for c in (ours, theirs))
+        relevance = (ours or theirs or {}).get("relevance")
         if still_open and figure in ("5.1", "5.2"):
             remark += " " + hypotheses_sentence(tested[curve])
         if still_open and (figure, curve) in spread:
@@ -142,8 +145,11 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
                 if theirs is not None and processed and figure in ("5.1", "5.2") else first.kind)
         b.add(RowSpec(id=f"figure-{figure}/{curve}", group=group, quantity=f"{curve}: {first.quantity}",
               where=first.where, thesis=f"the authors' curve ({kind})",
-              ours="-" if ours is None else ours["text"], difference="-", ok=None if ours is None else ours["holds"],
-              rule="curve-band", kind="whole curve", page=page, heading=heading,
+              ours="-" if ours is None else ours["text"], difference="-", ok=None,
+              test=None if ours is None else ours["test"], relevance=relevance,
+              sources=() if ours is None else (f"{first.experiment}/{curve}",),
+              relevance_text=relevance_text("scale", relevance or 0.0), rule="curve", kind="whole curve", page=page,
+              heading=heading,
               ours_value=None if ours is None else ours["share"],
               seeds=None if ours is None else ours["seeds"], interval_text="" if ours is None else ours["band"],
               output=Output(value=None, text=f"their {runs} runs" if runs > 1 else "their curve", source=first.source),

@@ -13,13 +13,16 @@ from safepg.thesis.scorecard.rules import (
     AUTHORS_ERROR_STATUS,
     AUTHORS_STATUS,
     GROUPS,
+    INCONCLUSIVE_STATUS,
     KIND_RULE,
+    RELEVANCE,
     RULES,
     STATUS_RULE,
     STATUSES,
     VACUOUS_STATUS,
     Row,
 )
+from safepg.thesis.scorecard.verdicts import CORRECTION, FDR_LEVEL
 
 
 def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
@@ -36,6 +39,7 @@ def counts(rows: Iterable[Row]) -> dict[str, dict[str, int]]:
 STATUS_PHRASES = {"reproduced": "reproduced", AUTHORS_STATUS: "reproduced only with the authors' unprinted settings",
                   AUTHORS_ERROR_STATUS: "reproduced only through an error in the authors' code",
                   VACUOUS_STATUS: "that agree without carrying information",
+                  INCONCLUSIVE_STATUS: "inconclusive",
                   "differs (explained)": "that differ for a reason the book explains", "open": "open"}
 
 
@@ -52,7 +56,8 @@ def counts_text(rows: Sequence[Row]) -> str:
 
 #: The short name of each status in :func:`headline_numbers`' keys (``n_<name>``).
 STATUS_KEYS = {"reproduced": "reproduced", AUTHORS_STATUS: "authors_settings", AUTHORS_ERROR_STATUS: "authors_error",
-               VACUOUS_STATUS: "no_information", "differs (explained)": "explained", "open": "open"}
+               VACUOUS_STATUS: "no_information", INCONCLUSIVE_STATUS: "inconclusive",
+               "differs (explained)": "explained", "open": "open"}
 
 
 def headline_numbers(rows: Sequence[Row]) -> dict[str, float]:
@@ -79,7 +84,9 @@ def headline_numbers(rows: Sequence[Row]) -> dict[str, float]:
 
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
 CSV_COLUMNS = ("id", "group", "quantity", "where", "kind", "thesis", "ours", "difference", "status", "judged_on",
-               "rule", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
+               "rule", "test", "p_value", "authors_p_value", "level", "detectable", "relevance", "relevance_text",
+               "seeds_needed", "authors_seeds_needed", "state", "authors_state", "verdict",
+               "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
                "explanation", "link", "thesis_value", "ours_value", "ours_ci95_low", "ours_ci95_high", "seeds",
                "authors", "authors_value", "authors_ci95_low", "authors_ci95_high", "authors_seeds",
                "authors_experiment", "authors_output", "authors_output_value", "authors_output_source", "slip")
@@ -136,7 +143,9 @@ def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **k
     out_dir = Path(path_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written: dict[str, Path] = {}
-    meta = {"kinds": KIND_RULE, "rules": RULES, "status_rule": STATUS_RULE, "counts": counts(rows)}
+    meta = {"kinds": KIND_RULE, "rules": RULES, "status_rule": STATUS_RULE, "relevance": RELEVANCE,
+            "correction": {"method": "Benjamini-Hochberg", "false_discovery_rate": FDR_LEVEL, "why": CORRECTION},
+            "counts": counts(rows)}
     p = out_dir / "scorecard.json"
     p.write_text(json.dumps({**meta, "rows": [r.to_dict() for r in rows]}, indent=1, ensure_ascii=False) + "\n",
                  encoding="utf-8")
@@ -149,7 +158,8 @@ def write_scorecard(path_dir: Path | str, rows: Sequence[Row] | None = None, **k
         keys = list(dict.fromkeys(k for r in sel for k in r.fields))
         flat = [{**r.fields, **_flat(r)} for r in sel]
         cols = [*keys, "quantity", "kind", "thesis", "ours", "ours_ci95_low", "ours_ci95_high", "difference", "status",
-                "judged_on", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
+                "judged_on", "test", "p_value", "authors_p_value", "level", "detectable", "relevance", "seeds_needed",
+                "verdict", "judged_interval_low", "judged_interval_high", "judged_interval_text", "judged_seeds",
                 "thesis_value", "ours_value", "seeds", "authors", "authors_value", "authors_ci95_low",
                 "authors_ci95_high", "authors_seeds", "authors_experiment", "authors_output", "authors_output_value",
                 "authors_output_source", "slip", "id", "link"]

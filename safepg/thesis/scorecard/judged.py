@@ -4,6 +4,7 @@ lies among many of ours."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -12,13 +13,22 @@ import numpy as np
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
 from safepg.options import FixedStep, Vanilla
+from safepg.significance import AllOf, PredictionTest
 from safepg.stats import prediction_interval95
 from safepg.thesis import authors
 from safepg.thesis.analysis import one_cell_spread
 from safepg.thesis.experiments import Experiment, method_of
 from safepg.thesis.scorecard import outputs
-from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns, in_prediction, intervals_overlap, is_slip
+from safepg.thesis.scorecard.rules import (
+    FROZEN_THETA,
+    TailRuns,
+    half_unit,
+    in_prediction,
+    intervals_overlap,
+    is_slip,
+)
 from safepg.thesis.scorecard.text import pct
+from safepg.thesis.scorecard.verdicts import RELEVANT_SHARE
 
 
 def prediction(d: Mapping[str, Any] | None, ratio: bool = False) -> list[float] | None:
@@ -135,3 +145,74 @@ def slip_sentence(out: outputs.Output, printed: str, show: Callable[[float], str
         return ""
     return (f"Slip between the authors' output and the print: their run gives {show(scale * out.value)} "
             f"({out.source}), the thesis prints {show(float(printed))}.")
+
+
+# ------------------------------------------------------------------ the tests of the rows judged on runs
+def printed_interval(printed: str, scale: float = 1.0, integer_unit: bool = False) -> tuple[float, float]:
+    """A printed number as the interval its digits cover, value ± half a unit of the last one (times
+    ``scale``: 0.01 brings a printed percentage to a ratio); a printed 0 is exactly 0. ``integer_unit``: an
+    integer's last digit is its units digit ("100%" is 99.5% to 100.5%), not its last non-zero one."""
+    v = float(printed) * scale
+    if v == 0:
+        return 0.0, 0.0
+    h = (0.5 if integer_unit and "." not in printed and "e" not in printed.lower() else half_unit(printed)) * scale
+    return v - h, v + h
+
+
+def value_test(printed: str, values: Sequence[float] | None, reading: float | None = None) -> PredictionTest | None:
+    """The prediction t-test of a number printed from one run against our runs' ``values`` (None without two):
+    the printed interval is its digits' (:func:`printed_interval`), or ± ``reading`` for a number read off a
+    figure."""
+    if values is None or len(values) < 2:
+        return None
+    v = float(printed)
+    interval = printed_interval(printed) if reading is None else (v - reading, v + reading)
+    return PredictionTest(interval, tuple(float(x) for x in values))
+
+
+def ratio_test(printed: float, row: Mapping[str, Any] | None, text: str | None = None) -> PredictionTest | None:
+    r"""The prediction t-test of a printed improvement ratio (a fraction) against a report's ``row``: the
+    printed percentage's digits, widened by half an update's share :math:`1/(2n)` (:math:`n`: the smaller of
+    the two update counts in use, ours and the authors': the ratio's own last digit); where every run of ours
+    gives the same ratio, the spread is the binomial spread of :math:`n` updates at our rate of worsening ones,
+    :math:`\sqrt{\hat q (1 - \hat q)/n}`, :math:`\hat q = (\text{worsening} + 1/2)/(\text{updates} + 1)`.
+    ``text``: the percentage as printed (default: the shortest that gives ``printed``; "100" for 100%).
+    None without two runs."""
+    if row is None:
+        return None
+    values = row["improvement_ratio"].get("values") or []
+    if len(values) < 2:
+        return None
+    n = float(np.mean(row["updates"])) - 1
+    if n < 1:
+        return None
+    worse = float(np.sum([(1 - v) * n for v in values]))
+    q = (worse + 0.5) / (n * len(values) + 1)
+    return PredictionTest(printed_interval(text or f"{100 * printed:.6g}", 0.01, integer_unit=True),
+                          tuple(float(v) for v in values),
+                          resolution=0.5 / n, sd_floor=math.sqrt(q * (1 - q) / n))
+
+
+def order_test(exponent: int, medians: Sequence[Sequence[float]]) -> AllOf | None:
+    """The test of "of the order of 10^exponent" in every configuration: per configuration, the prediction
+    t-test of its runs' median steps, on a log10 scale, against [exponent, exponent + 1]; Bonferroni over the
+    configurations. ``medians``: each configuration's runs' median steps (None without two runs in each)."""
+    if not medians or any(len(m) < 2 for m in medians):
+        return None
+    return AllOf(tuple(PredictionTest((float(exponent), float(exponent + 1)),
+                                      tuple(math.log10(v) for v in m)) for m in medians))
+
+
+def never_moved_test(moves: Sequence[Sequence[float]]) -> AllOf | None:
+    """The test of "never updates these components": per printed component, the prediction t-test of each
+    run's largest move of it against exactly 0; Bonferroni over the components. ``moves``: per component, each
+    run's largest |theta - theta_0| (None without two runs)."""
+    if not moves or any(len(m) < 2 for m in moves):
+        return None
+    return AllOf(tuple(PredictionTest((0.0, 0.0), tuple(float(v) for v in m)) for m in moves))
+
+
+def value_relevance(printed: str, reading: float = 0.0) -> float:
+    """The difference that matters for a printed number: :data:`RELEVANT_SHARE` of it, never less than half a
+    unit of its last digit or its reading precision."""
+    return max(RELEVANT_SHARE * abs(float(printed)), half_unit(printed), reading)

@@ -13,7 +13,14 @@ from safepg.thesis.authors import REPOSITORY
 from safepg.thesis.citations import escape_and_link
 from safepg.thesis.scorecard.export import counts
 from safepg.thesis.scorecard.links import heading_id
-from safepg.thesis.scorecard.rules import AUTHORS_ERROR_STATUS, AUTHORS_STATUS, STATUSES, VACUOUS_STATUS, Row
+from safepg.thesis.scorecard.rules import (
+    AUTHORS_ERROR_STATUS,
+    AUTHORS_STATUS,
+    INCONCLUSIVE_STATUS,
+    STATUSES,
+    VACUOUS_STATUS,
+    Row,
+)
 
 
 # The tables scroll inside their own box (never the page) with "scroll shadows": a shadow
@@ -29,7 +36,8 @@ def _style_sheet() -> str:
 
 
 _STATUS_CLASS = {"reproduced": "sc-reproduced", AUTHORS_STATUS: "sc-authors", AUTHORS_ERROR_STATUS: "sc-error",
-                 VACUOUS_STATUS: "sc-vacuous", "differs (explained)": "sc-explained", "open": "sc-open"}
+                 VACUOUS_STATUS: "sc-vacuous", INCONCLUSIVE_STATUS: "sc-inconclusive",
+                 "differs (explained)": "sc-explained", "open": "sc-open"}
 _HINT = ("<p class=\"sc-hint\">Wide table: it scrolls sideways inside its box (a shadow at an edge marks more "
          "columns).</p>")
 
@@ -101,11 +109,13 @@ def _source_link(source: str) -> str:
 
 
 def _judged_html(r: Row) -> str:
-    """What the status was judged on: the column and its interval (nothing for a closed form)."""
-    if not r.judged_interval_text:
+    """What the status was judged on: the column and its test (a row judged on runs) or its interval
+    (nothing for a closed form)."""
+    text = r.verdict or r.judged_interval_text
+    if not text:
         return ""
     on = "ours, authors' settings" if r.judged_on == "authors' settings" else "ours"
-    return f'<span class="sc-detail sc-on">on {html.escape(on)}: {html.escape(r.judged_interval_text)}</span>'
+    return f'<span class="sc-detail sc-on">on {html.escape(on)}: {html.escape(text)}</span>'
 
 
 def _authors_cells(r: Row) -> str:

@@ -101,6 +101,11 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
     return rows if pages is None else _on_pages(rows, pages)
 
 
+def build_rows(root: Path, book: Path = BOOK) -> list[Row]:
+    """Every row, built afresh from the runs stored under ``root`` (none computed, nothing stored)."""
+    return _build(root, False, None, -1, book)
+
+
 def _default_experiments() -> dict[str, Experiment]:
     """The experiments whose missing runs ``run=True`` computes: :data:`NEEDED` and the range variant."""
     exps = {n: get_experiment(n) for n in NEEDED}

@@ -30,14 +30,17 @@ AUTHORS_ERROR_STATUS: Final = "reproduced only through an error in the authors' 
 #: ratio of a run whose theta does not move (consecutive batch means then differ by noise alone, so any
 #: such run scores about 50%, or 100% when no update is taken). The agreement carries no information.
 VACUOUS_STATUS: Final = "agrees, but carries no information"
+#: The status of a row whose tests reject on no column but could not have detected a difference that
+#: matters on any: not rejecting is not reproducing.
+INCONCLUSIVE_STATUS: Final = "inconclusive"
 Status = Literal["reproduced", "reproduced only with the authors' unprinted settings",
                  "reproduced only through an error in the authors' code", "agrees, but carries no information",
-                 "differs (explained)", "open"]
+                 "inconclusive", "differs (explained)", "open"]
 #: The statuses, in the order the page lists them: the two that reproduce the printed number, the two
 #: counted apart (agreement through an error of the authors' code, agreement without information),
-#: then the two that do not reproduce it.
+#: the rows whose tests could not decide, then the two that do not reproduce it.
 STATUSES: tuple[Status, ...] = ("reproduced", AUTHORS_STATUS, AUTHORS_ERROR_STATUS, VACUOUS_STATUS,
-                                "differs (explained)", "open")
+                                INCONCLUSIVE_STATUS, "differs (explained)", "open")
 #: The columns a status can be judged on (:attr:`Row.judged_on`).
 JUDGED_ON = ("ours", "authors' settings")
 #: A run whose every component of theta moves by less than this over the whole run is frozen: its
@@ -56,19 +59,36 @@ KIND_RULE: dict[str, str] = {
     "closed form": "A formula or a number that follows from the task alone: judged exactly, or at the rounding "
                    "of its last printed digit.",
     "one run": "A number printed from one run of the authors (Table 5.1's cells, Tables 5.3 and 5.4, the 2-D runs' "
-               "final parameters and ratios, the baseline's iteration count): judged against our 95% prediction "
-               "interval for one run, mean ± t(0.975, k-1)·s·√(1 + 1/k) over our k seeds (the seed count is in "
-               "the row). The interval of our mean would reject single runs that our own seeds produce routinely.",
-    "mean of runs": "A number printed as a mean over runs with its interval (Table 5.2): judged against the 95% "
-                    "interval of our mean over seeds: two estimates of the same mean.",
-    "read off a figure": "A number the text reads off a figure (\"N ≈ 500\", \"of the order of 1e-6\"): judged at "
-                         "the reading precision the row states, against our prediction interval for one run where "
-                         "the figure shows one run.",
-    "whole curve": "An authors' curve from their raw output: the share of it, at their x-values in the plotted "
-                   "range, that lies inside our pointwise 95% prediction band for the kind of curve they plotted "
-                   "(one run, or a mean of n runs: mean ± t·s·√(1/n + 1/k)).",
+               "final parameters and ratios, the baseline's iteration count): a prediction t-test of that one run "
+               "against our k runs, T = d / (s·√(1 + 1/k)) with k - 1 degrees of freedom. The interval of our mean "
+               "would reject single runs that our own seeds produce routinely.",
+    "mean of runs": "A number printed as a mean over runs with its interval (Table 5.2): Welch's t-test of two "
+                    "estimates of the same mean, the printed interval giving the spread of their runs.",
+    "read off a figure": "A number the text reads off a figure (\"N ≈ 500\", \"of the order of 1e-6\"): the "
+                         "prediction t-test against the printed value give or take the reading precision the row "
+                         "states.",
+    "whole curve": "An authors' curve from their raw output, as its means over three equal blocks of the plotted "
+                   "range: their runs against ours by the two-sample Hotelling T² and its exact permutation p-value "
+                   "where their history holds several runs (Figures 5.1-5.4), else their one run by Hotelling's T² for "
+                   "one new curve. The share of their curve inside our pointwise 95% band stays beside it, to say "
+                   "where the curves part.",
     "statement": "A claim about every configuration or every update (\"an improvement ratio of 1 ... also with "
                  "large values of delta\", \"never updates beta\"): judged by its own rule on all our runs.",
+}
+
+#: What difference matters, by quantity: a column that is not rejected reproduces the printed number only
+#: when its test would have detected that much (with 80% power, at the level it faced).
+RELEVANCE: dict[str, str] = {
+    "improvement ratio": "5 points: a twentieth of a ratio's range, the scorecard's tolerance for a ratio "
+                         "claimed of every configuration.",
+    "a performance, an iteration count, a batch size, a step": "5% of the printed value, and never less than the "
+                                                               "printed precision or reading.",
+    "a final parameter": "5% of the largest printed entry of its matrix: the off-diagonal entries near 0 are "
+                         "judged on the matrix's scale.",
+    "an order of magnitude": "one decade.",
+    "a parameter that never moves, a printed 0": "none: every run must give it exactly.",
+    "a whole curve": "5% of the range of the authors' values over the plotted range, the same shift in every "
+                     "block.",
 }
 
 #: Groups of rows, in the order of the thesis (and of the page).
@@ -111,46 +131,59 @@ RULES: dict[str, str] = {
                    "recorded, with its explanation, by safepg.thesis.errata.errata().",
     "rounded": "A printed number: reproduced when |ours - thesis| is at most half a unit of its last printed "
                "digit (-0.59 covers -0.595 to -0.585; a printed 0 must be exactly 0).",
-    "ci-overlap": "Table 5.2 (a mean over 5 runs with its 95% interval): reproduced when our 95% interval over "
-                  "5 seeds overlaps the printed one (two estimates of the same mean).",
-    "prediction": "A number from one run: reproduced when the printed value lies in our 95% prediction interval "
-                  "for one run, mean ± t(0.975, k-1)·s·√(1 + 1/k) over our k seeds, widened by half a unit of its "
-                  "last printed digit (a printed 0 must be exactly 0 in every seed). An improvement ratio takes "
-                  "the values k/n of its run's n updates: its interval is also widened by one update's share, so that "
-                  "seeds that all agree (100% on a run that improves at each update) do not reject a run that differs "
-                  "from them by one update.",
-    "reading": "A number read off a figure of one run (\"≈ 500\"): reproduced when the printed value, give or take "
-               "the reading precision the row states (half a unit of its last significant digit), meets our 95% "
-               "prediction interval for one run.",
+    "welch": "Table 5.2 (a mean over 5 runs with its 95% interval): Welch's t-test of the printed mean against "
+             "our k runs, the printed interval ȳ ± h giving their standard deviation s = h·√5 / t(0.975, 4), "
+             "the printed mean widened by half a unit of its last digit; Welch-Satterthwaite degrees of freedom.",
+    "prediction": "A number from one run: the prediction t-test. The printed value, widened by half a unit of its "
+                  "last digit, lies at distance d from the mean of our k runs; T = d / (s·√(1 + 1/k)), with s our "
+                  "runs' standard deviation, is Student-t with k - 1 degrees of freedom for normal runs. An "
+                  "improvement ratio takes the values i/n of its run's n updates: it is also widened by one "
+                  "update's share, so that seeds that all agree (100% on a run that improves at each update) do not "
+                  "reject a run that differs from them by one update; where all our seeds give the same ratio, s "
+                  "is the binomial spread of n updates at our rate of worsening ones. A printed 0 that every run of "
+                  "ours gives exactly is reproduced exactly.",
+    "reading": "A number read off a figure of one run (\"≈ 500\"): the prediction t-test against the printed "
+               "value give or take the reading precision the row states (half a unit of its last significant "
+               "digit).",
     "ratio-points": f"An improvement ratio claimed of every configuration: reproduced when |ours - thesis| <= "
                     f"{RATIO_POINTS:g} percentage points for the lowest of them.",
-    "order": "\"Of the order of 10^k\": reproduced when the order of magnitude of our median, "
-             "10^floor(log10 x), is 10^k for every configuration.",
-    "set": "A set of components: reproduced when ours is the printed one.",
-    "curve-band": "A whole curve: reproduced when at least 90% of the authors' curve, at their x-values in the "
-                  "plotted range, lies in our pointwise 95% prediction band.",
+    "order": "\"Of the order of 10^k\" in every configuration: the prediction t-test of each configuration's "
+             "median step, on a log10 scale, against the decade [k, k + 1), Bonferroni over the configurations.",
+    "set": "Components that never move: the prediction t-test of each printed component's largest move over a "
+           "run against exactly 0, Bonferroni over the components; only runs that all leave them exactly where "
+           "they started reproduce the print.",
+    "curve": "A whole curve as its means over three equal blocks of the plotted range: their runs against ours "
+             "by the two-sample Hotelling T² (pooled covariance) and its exact permutation distribution where "
+             "their history holds several runs; their one run by Hotelling's T² for one new curve, "
+             "(k - B)/(B(k - 1))·T² ~ F(B, k - B) for normal runs, where it holds one (the exact rank of their "
+             "curve among ours is beside it).",
 }
 
 #: Which column a status is judged on, and what a row that fails its rule means.
-STATUS_RULE = ("A row is judged first on \"ours\": our runs as the thesis's text describes them (the settings it "
-               "leaves unstated filled in by the library's defaults). It is \"reproduced\" when its rule holds "
-               "there. Otherwise, when the row has \"ours, authors' settings\" (our runs with what the authors' code "
-               "ran where the text says something else or nothing: their starting point, discount, constants, "
-               "counting or task), the same rule is applied to that column, and the row is \"" + AUTHORS_STATUS +
-               "\" when it holds there; the row names the setting that did it. Where a cell was run again under "
-               "the authors' settings with more seeds (Table 5.1's σ = 1, N = 1000, α = 1e-4: 50), that column "
-               "is judged on the larger sample. Where the authors' column holds only "
-               "through an error of their code (their 2-D J, 16 times the expectation), the row is \"" +
-               AUTHORS_ERROR_STATUS + "\". A rule that holds on a run that could not have done otherwise (an "
-               "improvement ratio of a run whose θ moves by less than " + f"{FROZEN_THETA:g}" + " in every "
-               "component: its consecutive batch means differ by noise alone) does not count: that column is "
-               "\"" + VACUOUS_STATUS + "\" unless the other one holds on a run that moved. A row that fails on both is "
-               "\"differs (explained)\" when the chapter that discusses it explains the gap (the one-sentence "
-               "explanation is in the row, with a link), and \"open\" otherwise, with a sentence saying what "
-               "evidence is missing. \"Authors' output\" is the authors' own raw output recomputed with their "
-               "plot scripts' rules (safepg.thesis.authors): it is shown, never judged; where the printed value is "
-               "more than one unit of its last digit away from it (neither its rounding nor its truncation), the "
-               "row names the slip between their output and the print, with both numbers.")
+STATUS_RULE = ("A row of closed forms is judged by its rule. A row measured on runs has a test on each column: "
+               "\"ours\", our runs as the thesis's text describes them (the settings it leaves unstated filled in "
+               "by the library's defaults), and, where the row has it, \"ours, authors' settings\" (our runs with "
+               "what the authors' code ran where the text says something else or nothing: their starting point, "
+               "discount, constants, counting or task). Every such test is corrected together with all the others "
+               "(the false discovery rate, below). A column is rejected when its test is among those the "
+               "correction rejects; a column that is not rejected is conclusive when its test would have detected "
+               "the difference that matters with 80% power at the level it faced, and inconclusive otherwise. The "
+               "row is \"reproduced\" when ours is conclusive; otherwise \"" + AUTHORS_STATUS + "\" when the "
+               "authors' column is, and the row names the setting that did it; where that column holds only "
+               "through an error of their code (their 2-D J, 16 times the expectation), \"" + AUTHORS_ERROR_STATUS +
+               "\". Where a cell was run again under the authors' settings with more seeds (Table 5.1's σ = 1, N "
+               "= 1000, α = 1e-4: 50), that column is tested on the larger sample. A column that agrees on a run "
+               "that could not have done otherwise (an improvement ratio of a run whose θ moves by less than " +
+               f"{FROZEN_THETA:g}" + " in every component: its consecutive batch means differ by noise alone) does "
+               "not count: it is \"" + VACUOUS_STATUS + "\" unless the other column is conclusive on a run that "
+               "moved. A row whose columns are not all rejected, none conclusive, is \"" + INCONCLUSIVE_STATUS +
+               "\", with the seeds that would decide it. A row rejected on every column is \"differs "
+               "(explained)\" when the chapter that discusses it explains the gap (the one-sentence explanation "
+               "is in the row, with a link), and \"open\" otherwise, with a sentence saying what evidence is "
+               "missing. \"Authors' output\" is the authors' own raw output recomputed with their plot scripts' "
+               "rules (safepg.thesis.authors): it is shown, never judged; where the printed value is more than "
+               "one unit of its last digit away from it (neither its rounding nor its truncation), the row names "
+               "the slip between their output and the print, with both numbers.")
 
 
 # ------------------------------------------------------------------ the notes' measured values
@@ -432,6 +465,29 @@ class Row:
     no_information : str
         Why one of our columns agrees with the print without information ("" when none does): the
         row is flagged, and counted at the top of the page, whatever its status.
+    test : str
+        The test of a row judged on runs (:mod:`safepg.significance`), "" for a closed form.
+    p_value, authors_p_value : float or None
+        Its two-sided p-value on ours and on ours under the authors' settings.
+    level : float or None
+        The threshold the judged column's test faced within the family (:mod:`~safepg.thesis.scorecard.verdicts`).
+    detectable : float or None
+        The smallest difference the judged column's test detects with 80% power at ``level``, in the units
+        of ``ours_value`` (a column not rejected).
+    relevance, relevance_text : float or None, str
+        The difference that matters for this row, and how it was set (:data:`RELEVANCE`).
+    seeds_needed, authors_seeds_needed : int or None
+        For an inconclusive column (ours; ours under the authors' settings): the seeds at which its test
+        would be conclusive (None: conclusive, rejected, or no number would).
+    test_text : str
+        What each column's test found, in words.
+    sources, authors_sources : list of str
+        The configurations behind each column, ``"experiment/config"``: the seed rule adds runs to them
+        (:mod:`safepg.thesis.seed_rule`).
+    state, authors_state : {"", "rejected", "conclusive", "inconclusive"}
+        Each column's test within the family ("" without a test).
+    verdict : str
+        The judged column's test in a few words (its p-value, seeds and detectable difference), for the page.
     """
 
     id: str
@@ -467,6 +523,21 @@ class Row:
     judged_interval_text: str = ""
     judged_seeds: int | None = None
     no_information: str = ""
+    test: str = ""
+    p_value: float | None = None
+    authors_p_value: float | None = None
+    level: float | None = None
+    detectable: float | None = None
+    relevance: float | None = None
+    relevance_text: str = ""
+    seeds_needed: int | None = None
+    authors_seeds_needed: int | None = None
+    test_text: str = ""
+    sources: list[str] = field(default_factory=list)
+    authors_sources: list[str] = field(default_factory=list)
+    state: str = ""
+    authors_state: str = ""
+    verdict: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

@@ -16,6 +16,7 @@ import numpy as np
 from safepg.learning import LearningRecord
 from safepg.options import Adaptive, FixedStep, Vanilla
 from safepg.runner import RunConfig
+from safepg.significance import Test, WelchTest
 from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment, method_of
 from safepg.thesis.scorecard import outputs
@@ -23,14 +24,17 @@ from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
 from safepg.thesis.scorecard.judged import (
     ci_judged,
     frozen,
-    one_run_ratio,
-    overlaps_printed,
+    never_moved_test,
+    order_test,
     pi_text,
     prediction,
     ratio_interval,
+    ratio_test,
     ratio_text,
     slip_sentence,
     tail_placement,
+    value_relevance,
+    value_test,
 )
 from safepg.thesis.scorecard.rules import (
     FROZEN_THETA,
@@ -46,11 +50,23 @@ from safepg.thesis.scorecard.rules import (
     Theta0s,
     half_unit,
     in_prediction,
-    intervals_overlap,
     order_of_magnitude,
     within_points,
 )
 from safepg.thesis.scorecard.text import ci_text, num, pct, signed
+from safepg.thesis.scorecard.verdicts import RELEVANT_SHARE, relevance_text
+
+
+def _points(v: float) -> str:
+    """A difference of two ratios, in percentage points."""
+    return f"{100 * v:.2g} points"
+
+
+#: Table 5.2's means are over this many runs of the authors ("All results are averaged over 5 runs").
+T52_PRINTED_RUNS = 5
+#: The relevance of an improvement ratio, and its words.
+RATIO_RELEVANCE = RELEVANT_SHARE
+RATIO_RELEVANCE_TEXT = relevance_text("ratio", RATIO_RELEVANCE, _points)
 
 
 def _cell(c: RunConfig) -> tuple[float, int, float]:
@@ -76,20 +92,22 @@ def _mean_ci(d: Mapping[str, Any]) -> tuple[float | None, list[float] | None]:
 
 
 def _authors(exp: Experiment | None, seeds: int, mean: float | None, ci: list[float] | None, text: str,
-             check: Callable[[float, list[float] | None], bool | None], *, interval: list[float] | None = None,
-             interval_text: str = "", vacuous: str = "") -> AuthorsColumn:
-    """Ours under the authors' settings: the cell, and the row's rule ``check(mean, ci)`` applied to it
-    when every seed of ``exp`` is stored, with the ``interval``, ``interval_text`` and ``vacuous`` of
-    that judgement."""
+             check: Callable[[float, list[float] | None], bool | None] | None = None, *, test: Test | None = None,
+             interval: list[float] | None = None, interval_text: str = "", vacuous: str = "",
+             sources: Sequence[str] = ()) -> AuthorsColumn:
+    """Ours under the authors' settings: the cell, and, when every seed of ``exp`` is stored, the row's
+    ``test`` (a row judged on runs) or its rule ``check(mean, ci)``, with the ``interval``, ``interval_text``
+    and ``vacuous`` of that judgement."""
     if exp is None:
         return AuthorsColumn()
-    column = AuthorsColumn(experiment=exp.name, seeds=seeds, text="-")
+    column = AuthorsColumn(experiment=exp.name, seeds=seeds, text="-", sources=tuple(sources))
     if mean is None or seeds == 0:
         return column
     column = replace(column, value=mean, ci95=ci, text=text)
     if seeds < exp.seeds:  # a partly computed campaign is shown, not judged
         return replace(column, text=f"{text} ({seeds} of {exp.seeds} seeds: not judged)")
-    return replace(column, ok=check(mean, ci), interval=interval, interval_text=interval_text, vacuous=vacuous)
+    return replace(column, ok=None if check is None else check(mean, ci), test=test, interval=interval,
+                   interval_text=interval_text, vacuous=vacuous)
 
 
 def _said(column: AuthorsColumn) -> str:
@@ -123,14 +141,13 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
             continue
         key = sigma, n, alpha = _cell(c)
         mean, ci = _mean_ci(r["improvement_ratio"])
-        ok = None if mean is None else one_run_ratio(thesis, r)
         a_exp, ar = theirs.get(key, (authors, None))
         a_mean, a_ci = _mean_ci(ar["improvement_ratio"]) if ar else (None, None)
         a_col = _authors(a_exp, ar["seeds"] if ar else 0, a_mean, a_ci,
                          pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True), lambda x: pct(x, 1)),
-                         lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
-                         interval=ratio_interval(ar), interval_text=ratio_text(ar),
-                         vacuous=frozen(ar and ar.get("theta_moved")))
+                         test=ratio_test(thesis, ar), interval=ratio_interval(ar), interval_text=ratio_text(ar),
+                         vacuous=frozen(ar and ar.get("theta_moved")),
+                         sources=(f"{a_exp.name}/{ar['name']}",) if a_exp is not None and ar else ())
         rc = recon.get(key)
         rc_mean = None if rc is None else rc["improvement_ratio"]["mean"]
         recon_text = "" if rc_mean is None else \
@@ -142,7 +159,9 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
               quantity=f"improvement ratio, σ = {sigma:g}, N = {n}, α = {alpha:.0e}", where="Table 5.1",
               thesis=pct(thesis),
               ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
-              difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=ok,
+              difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=None,
+              test=ratio_test(thesis, r), relevance=RATIO_RELEVANCE, relevance_text=RATIO_RELEVANCE_TEXT, show=_points,
+              sources=(f"{printed.name}/{c.name}",),
               rule="prediction", kind="one run", page="lqg1d", heading="Table 5.1", thesis_value=thesis,
               ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds,
               interval=ratio_interval(r), interval_text=ratio_text(r), vacuous=frozen(r.get("theta_moved")),
@@ -157,12 +176,15 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
 
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                     variant: Experiment | None, variant_rep: Mapping[str, Any] | None,
-                    authors: Experiment | None = None, authors_rep: Mapping[str, Any] | None = None) -> None:
+                    authors: Experiment | None = None, authors_rep: Mapping[str, Any] | None = None,
+                    settings: Experiment | None = None, settings_rep: Mapping[str, Any] | None = None) -> None:
     """Table 5.2 row by row. The two theoretical-range rows (Hoeffding and Bernstein without the
     empirical range) are judged on Lemma 4.3.3's range as printed (``variant``), then on the
     authors' settings: their formula for the range, 2 M_phi A_bar abs(A) R / (sigma^2 (1 - gamma))
     = 1280, which ``exp`` runs, and their step taken even when eps >= abs(g) (``authors``,
-    ``table-5.2-authors``; without it, ``exp`` stands for the authors' settings)."""
+    ``table-5.2-authors``; without it, ``exp`` stands for the authors' settings). The other rows'
+    authors' settings are ``settings`` (``figures-5.1-5.2-authors``: N_min and N_max from their run
+    files, the step taken even when eps >= abs(g))."""
     dec = TABLE_DECIMALS["table-5.2"]
     fmt = lambda x: num(x, dec)  # noqa: E731
     lemma = {}
@@ -181,6 +203,14 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         else:
             ratios.append(r["improvement_ratio"]["mean"])
         out = outputs.table_5_2(key)
+        printed_text = f"{th['upsilon_bar']:.{dec}f}"
+
+        def welch(row: Mapping[str, Any] | None, th: Mapping[str, Any] = th, text: str = printed_text) -> Test | None:
+            values = (row or {}).get("upsilon_bar", {}).get("values") or []
+            return None if len(values) < 2 else WelchTest(th["upsilon_bar"], tuple(th["ci95"]), T52_PRINTED_RUNS,
+                                                           tuple(values), half_unit(text))
+
+        test, source = welch(r), f"{exp.name}/{c.name}"
         seeds, a_col, note_id, guarded, range_runs = r["seeds"], AuthorsColumn(), None, "", None
         theoretical = bound != "chebyshev" and not empirical_range and key in lemma
         if theoretical:
@@ -190,40 +220,51 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             if authors is not None:
                 a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
                 a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", overlaps_printed(th["ci95"]),
-                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar["seeds"] if ar else None))
+                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", test=welch(ar),
+                                 interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar["seeds"] if ar else None),
+                                 sources=(f"{authors.name}/{c.name}",))
             else:
-                a_col = _authors(exp, seeds, mean, ci, guarded,
-                                 overlaps_printed(th["ci95"]), interval=ci, interval_text=ci_judged(ci, fmt, seeds))
+                a_col = _authors(exp, seeds, mean, ci, guarded, test=test, interval=ci,
+                                 interval_text=ci_judged(ci, fmt, seeds), sources=(f"{exp.name}/{c.name}",))
             mean, ci = _mean_ci(vr["upsilon_bar"])
-            seeds = vr["seeds"]
+            seeds, test, source = vr["seeds"], welch(vr), f"{variant.name}/{vc.name}" if variant else ""
             range_runs = RangeRuns(f"with Lemma 4.3.3's range ours is {fmt(mean)}{ci_text(ci, fmt)}, with the "
                                    f"authors' settings {a_col.text or '-'} over "
                                    f"{r['iterations'] or 0:.0f} iterations, theirs over {out.iterations}")
             note_id = "table-5.2/theoretical-range"
-        ok = None if mean is None or ci is None else intervals_overlap(ci, th["ci95"])
+        elif settings is not None and (sr := _report_row(settings_rep, c.name)) is not None:
+            s_mean, s_ci = _mean_ci(sr["upsilon_bar"])
+            a_col = replace(_authors(settings, sr["seeds"], s_mean, s_ci, f"{fmt(s_mean)}{ci_text(s_ci, fmt)}",
+                                     test=welch(sr), interval=s_ci, interval_text=ci_judged(s_ci, fmt, sr["seeds"]),
+                                     sources=(f"{settings.name}/{c.name}",)),
+                            note="Reproduced with the authors' settings: N_min and N_max from their run files' "
+                                 "headers (lqg/lqg_adabatch.py@eb78917:161) and the step taken even when ε ≥ "
+                                 "abs(g) (lqg/lqg_adabatch.py@eb78917:212-222), as figures-5.1-5.2-authors runs.")
         er = " (e.r.)" if empirical_range else ""
         label = f"{estimator}-{bound}{'-er' if empirical_range else ''}-delta={delta:g}"
         b.add(RowSpec(id=f"table-5.2/{label}", group="Section 5.1",
               quantity=f"average performance, {'REINFORCE' if estimator == 'reinforce' else 'G(PO)MDP'}, "
               f"{bound.capitalize()}{er}, δ = {delta:g}", where="Table 5.2",
               thesis=f"{fmt(th['upsilon_bar'])}{ci_text(th['ci95'], fmt)}", ours=f"{fmt(mean)}{ci_text(ci, fmt)}",
-              difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=ok, rule="ci-overlap",
+              difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=None, rule="welch",
+              test=test, relevance=value_relevance(printed_text), show=fmt, sources=(source,),
+              relevance_text=relevance_text("value", value_relevance(printed_text), fmt),
               kind="mean of runs", page="lqg1d", heading="Table 5.2", note_id=note_id, thesis_value=th["upsilon_bar"],
-              ours_value=mean, ours_ci95=ci, seeds=seeds, expected_seeds=exp.seeds, interval=ci,
+              ours_value=mean, ours_ci95=ci, seeds=seeds,
+              expected_seeds=variant.seeds if theoretical and variant is not None else exp.seeds, interval=ci,
               interval_text=ci_judged(ci, fmt, seeds),
-              authors=replace(a_col, note=(
+              authors=a_col if not guarded else replace(a_col, note=(
                   "Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the authors' "
                   "settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) = 1280 "
                   "(lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "
-                  f"their range and our guarded step (table-5.2): {guarded}.") if guarded else ""),
-              slip_note=slip_sentence(out, f"{th['upsilon_bar']:.{dec}f}", fmt),
+                  f"their range and our guarded step (table-5.2): {guarded}.")),
+              slip_note=slip_sentence(out, printed_text, fmt),
               fields={"estimator": estimator, "bound": bound, "empirical_range": empirical_range, "delta": delta,
                       "theoretical_range": None if theoretical else method_of(c, Adaptive).error.theoretical_range,
                       "thesis_ci95": list(th["ci95"])}, output=out, note_values=range_runs))
     # "Notice that an improvement ratio of 1 is achieved also with large values of delta."
-    complete = all(r["seeds"] == exp.seeds for r in rep["configs"])
+    complete = all(r["seeds"] >= exp.seeds for r in rep["configs"])
     got = [x for x in ratios if x is not None] if complete else []
     low = min(got) if got else None
     b.add(RowSpec(id="section-5.1/improvement-ratio-adaptive", group="Section 5.1",
@@ -235,46 +276,54 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
           remark=f"Left out, θ frozen (moving by less than {FROZEN_THETA:g}): {', '.join(still)}." if still else ""))
 
 
-def _median_steps(recs: Mapping[str, Sequence], names: list[str], seeds: int) -> list[float] | None:
-    """Median positive step of each configuration, or None unless every seed of each is stored."""
+def _seed_medians(recs: Mapping[str, Sequence], names: list[str], seeds: int) -> list[list[float]] | None:
+    """Each configuration's runs' median positive steps, or None unless every seed of each is stored and has
+    a step."""
     if any(len(recs.get(n, [])) < seeds for n in names):  # judged on the whole campaign only
         return None
-    medians = []
+    out = []
     for n in names:
-        steps = np.concatenate([r.alpha[r.alpha > 0] for r in recs.get(n, [])] or [np.empty(0)])
-        if not steps.size:
+        medians = [float(np.median(r.alpha[r.alpha > 0])) for r in recs.get(n, []) if np.any(r.alpha > 0)]
+        if len(medians) < len(recs.get(n, [])) or not medians:
             return None
-        medians.append(float(np.median(steps)))
-    return medians
+        out.append(medians)
+    return out
 
 
 def _step_rows(b: Builder, *, rid: str, group: str, where: str, quantity: str, recs: Mapping[str, Sequence],
-               names: Iterable[str], exponent: int, page: str, heading: str, seeds: int,
+               names: Iterable[str], exponent: int, page: str, heading: str, seeds: int, experiment: str,
                authors: Experiment | None = None, authors_recs: Mapping[str, Sequence] | None = None,
                output: outputs.Output | None = None, authors_note: str = "") -> None:
+    """A step size "of the order of 10^exponent" in every configuration ``names`` of ``recs`` (and of
+    ``authors``): each configuration's median step, judged by :func:`~safepg.thesis.scorecard.judged.order_test`
+    on each seed's median."""
     names = list(names)
-    medians = _median_steps(recs, names, seeds)
-    if medians:  # "in all the experiments": every configuration run
+    per_seed = _seed_medians(recs, names, seeds)
+    if per_seed:  # "in all the experiments": every configuration run
+        medians = [float(np.median(m)) for m in per_seed]
         ours = f"median {np.median(medians):.1e}" + \
                (f" (per configuration {min(medians):.1e} to {max(medians):.1e})" if len(medians) > 1 else "")
-        ok = all(order_of_magnitude(m) == exponent for m in medians)
         value = float(np.median(medians))
         diff = f"order 10^{order_of_magnitude(value)}"
     else:
-        ours, ok, value, diff = "-", None, None, "-"
+        ours, value, diff = "-", None, "-"
     a_col = AuthorsColumn()
     if authors is not None:
         a_names = [c.name for c in authors.configs]
         got = dict(authors_recs or {})
-        a_med = _median_steps(got, a_names, 1) or []  # no medians: None and [] alike
         n_seeds = min((len(got.get(n, [])) for n in a_names), default=0)
+        a_seed = _seed_medians(got, a_names, max(n_seeds, 1)) or []
+        a_med = [float(np.median(m)) for m in a_seed]
         a_col = _authors(authors, n_seeds, float(np.median(a_med)) if a_med else None, None,
-                         f"median {np.median(a_med):.1e}" if a_med else "-",
-                         lambda *_: all(order_of_magnitude(m) == exponent for m in a_med))
+                         f"median {np.median(a_med):.1e}" if a_med else "-", test=order_test(exponent, a_seed),
+                         sources=tuple(f"{authors.name}/{n}" for n in a_names))
     b.add(RowSpec(id=rid, group=group, quantity=quantity, where=where, thesis=f"of the order of 1e{exponent}",
-          ours=ours,
-          difference=diff, ok=ok, rule="order", kind="read off a figure", page=page, heading=heading,
-          thesis_value=10.0**exponent, ours_value=value, interval_text="reading precision: an order of magnitude",
+          ours=ours, difference=diff, ok=None, test=order_test(exponent, per_seed or []), relevance=1.0,
+          sources=tuple(f"{experiment}/{n}" for n in names),
+          relevance_text=relevance_text("decade", 1.0), show=lambda v: f"{v:.2g} decades", rule="order",
+          kind="read off a figure", page=page, heading=heading, thesis_value=10.0**exponent, ours_value=value,
+          interval_text="reading precision: an order of magnitude", seeds=min((len(m) for m in per_seed or []),
+                                                                               default=None),
           authors=replace(a_col, note=authors_note), output=output))
 
 
@@ -291,7 +340,8 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                   where="Section 5.2.1 (Figure 5.5)", thesis=pct(th["improvement_ratio"]),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
                   difference="-" if mean is None else f"{100 * (mean - th['improvement_ratio']):+.2f} points",
-                  ok=None if mean is None else one_run_ratio(th["improvement_ratio"], r),
+                  ok=None, test=ratio_test(th["improvement_ratio"], r), relevance=RATIO_RELEVANCE,
+                  relevance_text=RATIO_RELEVANCE_TEXT, show=_points, sources=(f"{exp.name}/{c.name}",),
                   rule="prediction", kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6",
                   thesis_value=th["improvement_ratio"], ours_value=mean, ours_ci95=ci, seeds=r["seeds"],
                   expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
@@ -299,6 +349,8 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         if "theta_final" in th:
             printed = np.asarray(th["theta_final"], dtype=float)
             finals = np.array([rec.theta_final.reshape(printed.shape) for rec in recs.get(c.name, [])])
+            # The matrix's scale: its off-diagonal entries near 0 are judged on it.
+            scale = RELEVANT_SHARE * float(np.max(np.abs(printed)))
             for (i, j), p in np.ndenumerate(printed):
                 text = repr(float(p)) if p != 0 else "0"
                 text = text[:-2] if text.endswith(".0") and "e" not in text else text
@@ -314,8 +366,11 @@ def _figures_5_5_5_6_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                       where="Section 5.2.1 (after Figure 5.5)", thesis=text,
                       ours="-" if mean is None else
                       f"{mean:.6g} (seeds {seeds.min():.6g} to {seeds.max():.6g})",
-                      difference="-" if mean is None else f"{mean - p:+.2g}",
-                      ok=None if mean is None else in_prediction(text, pi, list(seeds)), rule="prediction",
+                      difference="-" if mean is None else f"{mean - p:+.2g}", ok=None,
+                      test=value_test(text, list(seeds)), relevance=0.0 if p == 0 else scale,
+                      relevance_text=relevance_text("exact" if p == 0 else "scale", scale, lambda v: f"{v:.2g}")
+                      .replace("the authors' values", "the printed matrix's entries"),
+                      show=lambda v: f"{v:.2g}", rule="prediction", sources=(f"{exp.name}/{c.name}",),
                       kind="one run", page="lqg2d", heading="Figures 5.5 and 5.6", thesis_value=float(p),
                       ours_value=mean, seeds=int(seeds.size), expected_seeds=exp.seeds, interval=pi,
                       interval_text="every seed exactly 0" if p == 0 else pi_text(pi, lambda v: f"{v:.6g}",
@@ -346,13 +401,17 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
             pi, a_pi = prediction(r["upsilon_bar"]), prediction(ar and ar["upsilon_bar"])
             a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
             a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci, f"{fmt(a_mean)}{ci_text(a_pi, fmt)}",
-                             lambda *_, t=text, i=a_pi: in_prediction(t, i), interval=a_pi,
-                             interval_text=pi_text(a_pi, fmt, ar["seeds"] if ar else None))
+                             test=value_test(text, ar["upsilon_bar"].get("values") if ar else None), interval=a_pi,
+                             interval_text=pi_text(a_pi, fmt, ar["seeds"] if ar else None),
+                             sources=(f"{authors.name}/{c.name}",) if authors is not None and ar else ())
             out = output(c.name, "upsilon_bar") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/upsilon", group=group, quantity=f"average performance, {method}",
                   where=table.replace("table-", "Table "), thesis=text, ours=f"{fmt(mean)}{ci_text(pi, fmt)}",
-                  difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec),
-                  ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
+                  difference="-" if mean is None else signed(mean - th["upsilon_bar"], dec), ok=None,
+                  test=value_test(text, r["upsilon_bar"].get("values")), relevance=value_relevance(text),
+                  relevance_text=relevance_text("value", value_relevance(text), fmt), show=fmt,
+                  sources=(f"{table}/{c.name}",),
+                  rule="prediction", kind="one run",
                   page=page, heading=heading, thesis_value=th["upsilon_bar"], ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, fields={"method": c.name, "quantity": "upsilon_bar"},
                   interval=pi, interval_text=pi_text(pi, fmt, r["seeds"]),
@@ -367,16 +426,17 @@ def _upsilon_table_rows(b: Builder, table: str, exp: Experiment, rep: Mapping[st
             a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
                              pct(a_mean) + ci_text(prediction(ar and ar["improvement_ratio"], True),
                                                    lambda x: pct(x, 1)),
-                             lambda *_, t=thesis, d=ar: one_run_ratio(t, d),
-                             interval=ratio_interval(ar), interval_text=ratio_text(ar),
-                             vacuous=frozen(ar.get("theta_moved") if ar else None))
+                             test=ratio_test(thesis, ar), interval=ratio_interval(ar), interval_text=ratio_text(ar),
+                             vacuous=frozen(ar.get("theta_moved") if ar else None),
+                             sources=(f"{authors.name}/{c.name}",) if authors is not None and ar else ())
             out = output(c.name, "improvement_ratio") if output else None
             b.add(RowSpec(id=f"{table}/{c.name}/improvement-ratio", group=group,
                   quantity=f"improvement ratio, {method}",
                   where=table.replace("table-", "Table "), thesis=pct(thesis),
                   ours=pct(mean) + ci_text(prediction(r["improvement_ratio"], True), lambda x: pct(x, 1)),
-                  difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points",
-                  ok=None if mean is None else one_run_ratio(thesis, r), rule="prediction",
+                  difference="-" if mean is None else f"{100 * (mean - thesis):+.2f} points", ok=None,
+                  test=ratio_test(thesis, r), relevance=RATIO_RELEVANCE, relevance_text=RATIO_RELEVANCE_TEXT,
+                  show=_points, rule="prediction", sources=(f"{table}/{c.name}",),
                   kind="one run", page=page, heading=heading, thesis_value=thesis, ours_value=mean, ours_ci95=ci,
                   seeds=r["seeds"], expected_seeds=exp.seeds, interval=ratio_interval(r), interval_text=ratio_text(r),
                   vacuous=frozen(r.get("theta_moved")),
@@ -447,23 +507,30 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
         a_mean = float(np.mean(a_vals)) if a_vals else None
         pi, a_pi = prediction_interval95(vals)["pi95"], prediction_interval95(a_vals)["pi95"]
         reading = f"the print read to ± {half_unit(printed):g}"
+        precision = half_unit(printed)
         a_col = _authors(authors, len(a_vals), a_mean, None,
                          "-" if a_mean is None else f"{a_mean:.0f} (seeds {min(a_vals):.0f} to {max(a_vals):.0f})",
-                         lambda *_, i=a_pi, t=printed: in_prediction(t, i), interval=a_pi,
-                         interval_text=pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading))
+                         test=value_test(printed, a_vals, precision), interval=a_pi,
+                         interval_text=pi_text(a_pi, lambda v: f"{v:.0f}", len(a_vals), reading),
+                         sources=(f"{authors.name}/adaptive",) if authors is not None else ())
+        relevance = value_relevance(printed, precision)
         sizes = None if mean is None else BatchSizes(mean, out.text, _said(a_col))
         b.add(RowSpec(id=rid, group="Section 5.2", quantity=q, where="Section 5.2.1 (Figure 5.7)",
               thesis=f"≈ {printed}",
               ours="-" if mean is None else f"{mean:.0f} (seeds {min(vals):.0f} to {max(vals):.0f})",
               difference="-" if mean is None else f"{mean - float(printed):+.0f}",
-              ok=None if mean is None else in_prediction(printed, pi), rule="reading", kind="read off a figure",
+              ok=None, test=value_test(printed, vals, precision), relevance=relevance, sources=("table-5.3/adaptive",),
+              relevance_text=relevance_text("reading" if relevance == precision else "value", relevance,
+                                            lambda v: f"{v:.0f}"), show=lambda v: f"{v:.0f}",
+              rule="reading", kind="read off a figure",
               page="lqg2d", heading="Table 5.3", thesis_value=float(printed), ours_value=mean, seeds=len(vals),
               interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.0f}", len(vals), reading),
               expected_seeds=seeds, authors=replace(a_col, note=note),
               slip_note=slip_sentence(out, printed, lambda v: f"≈ {v:.0f}"), output=out, note_values=sizes))
     _step_rows(b, rid="section-5.2/step-order", group="Section 5.2", where="Section 5.2.1 (Figure 5.7)",
                quantity="step size of the adaptive batch-size runs", recs=recs, names=["adaptive"],
-               exponent=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds, authors=authors,
+               exponent=PRINTED["lqg2d_step_order"], page="lqg2d", heading="Table 5.3", seeds=seeds,
+               experiment="table-5.3", authors=authors,
                authors_recs=authors_recs, output=outputs.lqg2d("adaptive", "step"), authors_note=note)
 
 
@@ -473,6 +540,11 @@ def _table_5_3_extra_rows(b: Builder, recs: Mapping[str, Sequence[LearningRecord
 #: (theta_star.npy: one start for every seed), quoted beside it.
 T54_AUTHORS, T54_AUTHORS_THETA_STAR = "table-5.4-authors", "table-5.4-authors-theta-star"
 _STATE = ("x", "dx/dt", "β", "dβ/dt")  # the cart-pole's state [x, x_dot, beta, beta_dot]
+
+
+def _moves(recs: Sequence[LearningRecord], components: Sequence[int]) -> list[list[float]]:
+    """Per component, each run's largest move of it from where it started, max_t |theta_t - theta_0|."""
+    return [[float(np.max(np.abs(r.theta[:, c] - r.theta[0, c]))) for r in recs] for c in components]
 
 
 def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapping[str, Any]],
@@ -492,8 +564,9 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
         pi, a_pi = prediction_interval95(its)["pi95"], prediction_interval95(a_its)["pi95"]
         a_col = _authors(a_base, len(a_its), a_mean, None,
                          "-" if a_mean is None else f"{a_mean:.1f} (seeds {min(a_its):.0f} to {max(a_its):.0f})",
-                         lambda *_, i=a_pi, t=text: in_prediction(t, i), interval=a_pi,
-                         interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)))
+                         test=value_test(text, a_its), interval=a_pi,
+                         interval_text=pi_text(a_pi, lambda v: f"{v:.1f}", len(a_its)),
+                         sources=(f"{a_base.name}/{c.name}",) if a_base is not None else ())
         search = c.method
         assert isinstance(search, Vanilla) and isinstance(search.step, FixedStep) and search.target is not None
         b.add(RowSpec(id="section-5.3/baseline-iterations", group="Section 5.3",
@@ -501,7 +574,9 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
               f"{search.target.value:g}", where="Section 5.3", thesis=text,
               ours="-" if mean is None else f"{mean:.1f} (seeds {min(its):.0f} to {max(its):.0f})",
               difference="-" if mean is None else f"{mean - th['iterations']:+.1f}",
-              ok=None if mean is None else in_prediction(text, pi), rule="prediction", kind="one run",
+              ok=None, test=value_test(text, its), relevance=value_relevance(text),
+              relevance_text=relevance_text("value", value_relevance(text), lambda v: f"{v:.2g}"),
+              show=lambda v: f"{v:.2g}", rule="prediction", kind="one run", sources=(f"{base_exp.name}/{c.name}",),
               page="cartpole", heading="baseline policy", thesis_value=float(th["iterations"]), ours_value=mean,
               seeds=len(its), interval=pi, interval_text=pi_text(pi, lambda v: f"{v:.1f}", len(its)),
               expected_seeds=base_exp.seeds, output=outputs.cartpole("baseline", "iterations"),
@@ -515,7 +590,7 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
     never = PRINTED["cartpole_components_never_updated"]
     updated = None
     for r in rep54["configs"]:
-        if r["name"] == "adaptive" and r["seeds"] == exp54.seeds:  # the whole campaign only
+        if r["name"] == "adaptive" and r["seeds"] >= exp54.seeds:  # the whole campaign only
             updated = r["components_updated"]
     extra_text, extra_move = "", 0.0
     if updated is not None:
@@ -528,7 +603,8 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
     a_updated = a_row["components_updated"] if a_row and a_row["seeds"] else None
     a_col = _authors(a54, a_row["seeds"] if a_row else 0, None if a_updated is None else 0.0, None,
                      "-" if a_updated is None else ", ".join(_STATE[i] for i in range(4) if i not in a_updated),
-                     lambda *_: not set(a_updated or ()) & set(never))
+                     test=never_moved_test(_moves(recs.get(T54_AUTHORS, {}).get("adaptive", []), never)),
+                     sources=(f"{T54_AUTHORS}/adaptive",))
     theirs = outputs.cartpole_components_updated()
     # Without the whole campaign the row is not judged, and its note, which quotes what ours moves, not filled.
     moved = None if updated is None else MovedComponents(extra_text, extra_move, _said(a_col))
@@ -538,7 +614,9 @@ def _cartpole_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str
           ours="-" if updated is None else ", ".join(_STATE[i] for i in range(4) if i not in updated) or "none",
           difference="-" if updated is None else
           ("none" if not set(updated) & set(never) else "also updates " + extra_text),
-          ok=None if updated is None else not set(updated) & set(never), rule="set", kind="one run",
+          ok=None, test=never_moved_test(_moves(adaptive, never)) if updated is not None else None, relevance=0.0,
+          relevance_text=relevance_text("exact", 0.0), show=lambda v: f"{v:.1e}", rule="set", kind="one run",
+          sources=("table-5.4/adaptive",),
           page="cartpole", heading="Table 5.4",
           vacuous=frozen((_report_row(rep54, "adaptive") or {}).get("theta_moved")),
           # A set has no value: the 0.0 given to _authors only marks the column as measured.
@@ -580,11 +658,12 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
                     tail_placement(exps.get("table-5.1-authors-tail"), recs.get("table-5.1-authors-tail", {})),
                     exps.get("table-5.1-authors-tail"), reps.get("table-5.1-authors-tail"))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
-                    reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"))
+                    reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"),
+                    exps.get("figures-5.1-5.2-authors"), reps.get("figures-5.1-5.2-authors"))
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
                names=[c.name for c in exps["table-5.2"].configs], exponent=PRINTED["lqg1d_step_order"], page="lqg1d",
-               heading="Figures 5.3 and 5.4", seeds=exps["table-5.2"].seeds)
+               heading="Figures 5.3 and 5.4", seeds=exps["table-5.2"].seeds, experiment="table-5.2")
     _figures_5_5_5_6_rows(b, exps["figures-5.5-5.6"], reps["figures-5.5-5.6"], recs["figures-5.5-5.6"])
     _upsilon_table_rows(b, "table-5.3", exps["table-5.3"], reps["table-5.3"], "lqg2d", "Table 5.3", "Section 5.2",
                         exps.get("table-5.3-authors"), reps.get("table-5.3-authors"), _t53_output,

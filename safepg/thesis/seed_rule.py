@@ -1,0 +1,155 @@
+"""How many seeds each configuration runs: a starting count by the kind of row it feeds, and blocks of
+more where a row it feeds is inconclusive, up to a cap.
+
+One configuration feeds several rows of the scorecard (``table-5.2`` feeds Table 5.2, Figures 5.1-5.4
+and the step sizes), so the rule is applied per configuration: it runs the most seeds any row it feeds
+asks for. A row asks for the starting count of its kind (:data:`START_SEEDS`); a column of it that is
+inconclusive (:mod:`~safepg.thesis.scorecard.verdicts`: not rejected, its detectable difference above
+what matters) asks for the seeds that would make it conclusive, in whole blocks
+(:data:`~safepg.thesis.scorecard.verdicts.SEED_BLOCK`), at most :data:`SEED_CAP`, whether or not its test
+rejects: the seeds added are decided by the tests' detectable differences, which depend on the runs'
+spread and count, never on how far the printed number lies from ours, so that no test is repeated until
+it rejects. The authors' settings' column asks only where ours does not reproduce the print.
+
+:func:`plan_seeds` applies the rule to a results folder until nothing more is asked (the
+extra seeds go to the folder's :class:`~safepg.thesis.experiment_store.Campaign`); ``run-book`` calls
+it after the chapters' experiments.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TextIO
+
+from safepg.thesis.experiment_store import Campaign, read_campaign, run_experiments, write_campaign
+from safepg.thesis.experiments import CURVE_SEEDS, EXPERIMENTS, get_experiment
+from safepg.thesis.scorecard.rules import Row
+from safepg.thesis.scorecard.verdicts import RANDOM_KINDS, SEED_BLOCK
+
+#: The seeds a configuration starts with, by the kind of row it feeds (the most of its rows').
+START_SEEDS: dict[str, int] = {"one run": 5, "mean of runs": 5, "read off a figure": 5, "whole curve": CURVE_SEEDS}
+#: The most seeds the rule gives a configuration.
+SEED_CAP = 20
+#: The rule, as the scorecard page states it.
+SEED_RULE = (
+    "Each configuration starts with the seeds of the kind of row it feeds: " +
+    ", ".join(f"{n} for a row of {kind}" for kind, n in START_SEEDS.items()) + " (the most, where it feeds "
+    "several). Where the test of a column could not detect the difference that matters, its configurations "
+    f"get seeds in blocks of {SEED_BLOCK}, as many as the test needs, up to {SEED_CAP}; the authors' settings' "
+    "column asks only where ours does not reproduce the print. What is added depends on the runs' spread and count, "
+    "never on the p-value, so that no test is repeated until it rejects. The rule is applied again after each "
+    "addition, until no column asks for more.")
+
+
+def _asks(row: Row) -> list[tuple[Sequence[str], int]]:
+    """The seeds each column of a row asks for, with the configurations behind it: its start, or the seeds
+    its test needs to detect the difference that matters (whether or not it rejects; the authors' column
+    only where ours does not reproduce the print)."""
+    start = START_SEEDS[row.kind]
+    asks: list[tuple[Sequence[str], int]] = [(row.sources, start), (row.authors_sources, start)]
+    if row.seeds_needed is not None:
+        asks[0] = (row.sources, max(start, min(SEED_CAP, row.seeds_needed)))
+    if row.status != "reproduced" and row.authors_seeds_needed is not None:
+        asks[1] = (row.authors_sources, max(start, min(SEED_CAP, row.authors_seeds_needed)))
+    return asks
+
+
+def wanted_seeds(rows: Sequence[Row]) -> dict[str, int]:
+    """The seeds the rule gives each configuration the random rows read, by ``"experiment/config"``."""
+    out: dict[str, int] = {}
+    for row in rows:
+        if row.kind not in RANDOM_KINDS:
+            continue
+        for sources, seeds in _asks(row):
+            for src in sources:
+                out[src] = max(out.get(src, 0), seeds)
+    return out
+
+
+def _key(source: str) -> tuple[str, str]:
+    """(experiment, config key) of ``"experiment/config"``."""
+    name, config = source.split("/", 1)
+    return name, get_experiment(name).config(config).key()
+
+
+def planned_campaign(rows: Sequence[Row], campaign: Campaign) -> Campaign:
+    """``campaign`` with the seeds the rule asks for on ``rows`` where they are more than it and the
+    experiment's own (never fewer: what is stored stays counted)."""
+    seeds = dict(campaign.seeds)
+    for source, n in wanted_seeds(rows).items():
+        name, key = _key(source)
+        if n > max(get_experiment(name).seeds, seeds.get(key, 0)):
+            seeds[key] = n
+    return Campaign(campaign.first_seed, seeds)
+
+
+def added(campaign: Campaign) -> dict[str, int]:
+    """The configurations that run more seeds than their experiment's, by ``"experiment/config"``."""
+    out = {}
+    for exp in EXPERIMENTS.values():
+        for c in exp.configs:
+            n = campaign.seeds.get(c.key())
+            if n is not None and n > exp.seeds:
+                out[f"{exp.name}/{c.name}"] = n
+    return out
+
+
+def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -1, rounds: int = 6,
+               run: Callable[[list[str], Path, int], object] | None = None,
+               stream: TextIO | None = None) -> Campaign:
+    """Apply the rule to the results folder ``root`` until no column asks for more seeds.
+
+    Parameters
+    ----------
+    root : Path
+        The results folder; its campaign (:func:`~safepg.thesis.experiment_store.read_campaign`) gets the
+        added seeds.
+    build : callable
+        The scorecard's rows from the runs stored in a folder (``build(root)``).
+    jobs : int
+        Workers of the runs added (joblib's convention).
+    rounds : int
+        The most applications of the rule (each adds at least one block, so the cap ends it sooner).
+    run : callable, optional
+        ``run(experiment names, root, jobs)`` computes what the campaign now lacks (default
+        :func:`~safepg.thesis.experiment_store.run_experiments`).
+    stream : text stream, optional
+        Where each round's additions are said (default stdout).
+
+    Returns
+    -------
+    Campaign
+        The folder's campaign once the rule asks for nothing more.
+    """
+    stream = stream or sys.stdout
+    run = run or (lambda names, folder, n: run_experiments(names, jobs=n, root=folder, progress=False))
+    campaign = read_campaign(root)
+    for _ in range(rounds):
+        planned = planned_campaign(build(root), campaign)
+        more = {k: v for k, v in planned.seeds.items() if campaign.seeds.get(k) != v}
+        if not more:
+            return campaign
+        write_campaign(planned, root)
+        names = sorted({name for name, exp in EXPERIMENTS.items() for c in exp.configs if c.key() in more})
+        shown = {s: n for s, n in added(planned).items() if s.split("/", 1)[0] in names}
+        print(f"seed rule: more seeds for {len(more)} configuration{'s' * (len(more) != 1)}: "
+              + ", ".join(f"{s} ({n})" for s, n in shown.items()), file=stream, flush=True)
+        run(names, root, jobs)
+        campaign = planned
+    return campaign
+
+
+def seed_table(campaign: Campaign) -> list[Mapping[str, object]]:
+    """The configurations the rule gave more seeds, for the page: experiment, config, its experiment's seeds
+    and the campaign's."""
+    out: list[Mapping[str, object]] = []
+    for source, n in added(campaign).items():
+        name, config = source.split("/", 1)
+        out.append({"experiment": name, "config": config, "start": get_experiment(name).seeds, "seeds": n})
+    return out
+
+
+__all__ = ["SEED_CAP", "SEED_RULE", "START_SEEDS", "added", "plan_seeds", "planned_campaign", "seed_table",
+           "wanted_seeds"]
