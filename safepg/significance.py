@@ -289,8 +289,12 @@ def _covariance(y: np.ndarray) -> np.ndarray:
 
 
 def _quadratic(s: np.ndarray, v: np.ndarray) -> float:
-    r""":math:`v^\top S^{-1} v` by :func:`safepg.portable.solve`."""
-    return portable.dot(v, portable.solve(s, v[:, None])[:, 0])
+    r""":math:`v^\top S^{-1} v` by :func:`safepg.portable.solve` (NaN for a singular :math:`S`)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = portable.solve(s, v[:, None])[:, 0]
+    if not np.all(np.isfinite(x)):
+        return math.nan
+    return portable.dot(v, x)
 
 
 # ------------------------------------------------------------------ the tests
@@ -620,6 +624,8 @@ class CurvePredictionTest:
             return math.inf
         ones = np.ones(b)
         q = _quadratic(_covariance(self.ours[:, keep]), ones)
+        if not (math.isfinite(q) and q > 0):
+            return math.inf
         return math.sqrt(f_noncentrality(b, k - b, alpha, power) / (q / (1 + 1 / k)))
 
 
@@ -725,17 +731,21 @@ class PermutationTest:
             return 1.0
         observed = np.zeros((1, n), dtype=bool)
         observed[0, :m] = True
-        t_obs = float(_hotelling_two_sample(groups, observed)[0])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t_obs = float(_hotelling_two_sample(groups, observed)[0])
+        if not math.isfinite(t_obs):  # a singular pooled covariance: too few runs for the blocks
+            return math.nan
         if self.splits <= EXHAUSTIVE_PERMUTATIONS:
             idx = np.array(list(itertools.combinations(range(n), m)))
             mask = np.zeros((idx.shape[0], n), dtype=bool)
             np.put_along_axis(mask, idx, True, axis=1)
-            count, total, extra = 0, 0, 0
+            count, total = 0, 0
             for lo in range(0, mask.shape[0], 20_000):
-                t = _hotelling_two_sample(groups, mask[lo:lo + 20_000])
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    t = _hotelling_two_sample(groups, mask[lo:lo + 20_000])
                 count += int(np.sum(t >= t_obs * (1 - 1e-12)))
                 total += t.size
-            return (count + extra) / total
+            return count / total
         rng = np.random.default_rng(self.seed)
         count = 0
         for lo in range(0, MONTE_CARLO_PERMUTATIONS, 20_000):
@@ -743,7 +753,8 @@ class PermutationTest:
             order = np.argsort(rng.random((size, n)), axis=1)
             mask = np.zeros((size, n), dtype=bool)
             np.put_along_axis(mask, order[:, :m], True, axis=1)
-            count += int(np.sum(_hotelling_two_sample(groups, mask) >= t_obs * (1 - 1e-12)))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                count += int(np.sum(_hotelling_two_sample(groups, mask) >= t_obs * (1 - 1e-12)))
         return (1 + count) / (1 + MONTE_CARLO_PERMUTATIONS)
 
     def detectable_difference(self, alpha: float, seeds: float | None = None, power: float = POWER) -> float:
@@ -769,7 +780,10 @@ class PermutationTest:
             return 0.0
         a, o = groups[:m], groups[m:]
         pooled = ((m - 1) * _covariance(a) + (self.seeds - 1) * _covariance(o)) / (m + self.seeds - 2)
-        q = _quadratic(pooled, np.ones(b))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q = _quadratic(pooled, np.ones(b))
+        if not (math.isfinite(q) and q > 0):
+            return math.inf
         d2 = m + k - b - 1
         if d2 <= 0:
             return math.inf

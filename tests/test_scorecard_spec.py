@@ -19,7 +19,8 @@ from safepg.thesis.scorecard.text import MissingValueError, fill, template_field
 
 PLACE = dict(group="Section 5.3", quantity="q", where="Table 5.4", page="cartpole", heading="Table 5.4")
 CELLS = dict(thesis="53.01%", ours="48.64%", difference="-4.37 points")
-JUDGEMENT = dict(rule="prediction", kind="one run")
+# A row judged by its rule (``ok``); rows judged on runs take a test (tests/test_scorecard.py).
+JUDGEMENT = dict(rule="prediction", kind="closed form")
 
 
 class Reason(NamedTuple):
@@ -80,9 +81,10 @@ def test_every_note_declares_the_values_it_names():
 def test_a_failing_row_whose_note_lacks_its_values_fails_the_build(monkeypatch):
     monkeypatch.setitem(sc.NOTES, "t/", sc.Note("Because of {reason}.", "lqg1d", "Table 5.1", measured=Reason))
     b = Builder()
+    b.add(spec("t/failing", False))
     with pytest.raises(MissingValueError):
-        b.add(spec("t/failing", False))
-    assert not b.rows
+        b.rows  # noqa: B018  # judged when the rows are read
+    b = Builder()
     # Its runs missing or partly stored, the row is not judged and says so; the note is not needed.
     b.add(spec("t/missing", None))
     b.add(spec("t/partial", False, seeds=2, expected_seeds=5))
@@ -103,6 +105,13 @@ def test_a_row_spec_missing_a_required_field_cannot_be_built():
         del given[missing]
         with pytest.raises(TypeError, match=missing):
             RowSpec(**given)
+
+
+def test_a_row_judged_on_runs_takes_a_test_and_its_relevance():
+    with pytest.raises(ValueError, match="takes a test"):
+        RowSpec(id="t/row", ok=True, **PLACE, **CELLS, rule="prediction", kind="one run")
+    with pytest.raises(ValueError, match="relevance"):
+        RowSpec(id="t/row", ok=None, **PLACE, **CELLS, rule="prediction", kind="one run", test=object())
 
 
 def test_a_row_spec_has_no_undeclared_field():

@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 from scipy import stats as scipy_stats
+from scorecard_fakes import failing, passing
 
 from safepg.stats import mean_ci95, prediction_interval95, seed_summary95
 from safepg.thesis import scorecard as sc
@@ -61,31 +62,33 @@ def test_prediction_interval_needs_two_seeds_and_a_run_count():
 
 # ------------------------------------------------------------------ statuses
 COMMON = dict(group="Section 5.3", quantity="q", where="Table 5.4", thesis="53.01%", ours="48.64%",
-              difference="-4.37 points", rule="prediction", kind="one run", page="cartpole", heading="Table 5.4")
+              difference="-4.37 points", rule="prediction", kind="one run", page="cartpole", heading="Table 5.4",
+              relevance=1.0, ok=None)
 FROZEN = "θ moved by at most 3.0e-07 over the run: the ratio carries no information."
 
 
-def test_single_run_inside_and_outside_the_prediction_interval():
+def test_single_run_judged_by_its_test():
     b = Builder()
-    inside, outside = [41.8, 55.4], [41.8, 52.9]
-    b.add(RowSpec(id="r/inside", ok=sc.in_prediction("53.01", inside), interval=inside,
-                  interval_text="[41.8%; 55.4%]", seeds=5, **COMMON))
-    b.add(RowSpec(id="r/outside", ok=sc.in_prediction("53.01", outside), interval=outside,
-                  interval_text="[41.8%; 52.9%]", seeds=5, **COMMON))
+    b.add(RowSpec(id="r/inside", test=passing(), interval=[41.8, 55.4], interval_text="[41.8%; 55.4%]", seeds=5,
+                  **COMMON))
+    b.add(RowSpec(id="r/outside", test=failing(), interval=[41.8, 52.9], interval_text="[41.8%; 52.9%]", seeds=5,
+                  **COMMON))
     assert [r.status for r in b.rows] == ["reproduced", "open"]
-    assert b.rows[0].judged_interval == inside and b.rows[0].judged_seeds == 5 and b.rows[0].kind == "one run"
+    assert b.rows[0].judged_interval == [41.8, 55.4] and b.rows[0].judged_seeds == 5 and b.rows[0].kind == "one run"
+    assert b.rows[0].verdict.startswith("p = 0.9 (fake, 5 seeds); detects") and "differs" in b.rows[1].verdict
 
 
 def test_a_vacuous_ratio_is_not_reproduced():
     b = Builder()
-    b.add(RowSpec(id="v/ours", ok=True, vacuous=FROZEN, **COMMON))
+    b.add(RowSpec(id="v/ours", test=passing(), vacuous=FROZEN, **COMMON))
     # The authors' column moved and holds: the row is judged there, not on the frozen run.
-    b.add(RowSpec(id="v/authors", ok=True, vacuous=FROZEN, **COMMON,
-                  authors=AuthorsColumn(ok=True, text="52.6%", seeds=5, note="Their settings move θ.",
+    b.add(RowSpec(id="v/authors", test=passing(), vacuous=FROZEN, **COMMON,
+                  authors=AuthorsColumn(test=passing(), text="52.6%", seeds=5, note="Their settings move θ.",
                                         interval=[40.0, 60.0], interval_text="[40%; 60%]")))
     # Both columns frozen: vacuous, judged on the authors' column where only it holds.
-    b.add(RowSpec(id="v/both", ok=False, authors=AuthorsColumn(ok=True, vacuous=FROZEN, text="50%"), **COMMON))
-    b.add(RowSpec(id="v/moved", ok=True, vacuous="", **COMMON))
+    b.add(RowSpec(id="v/both", test=failing(), authors=AuthorsColumn(test=passing(), vacuous=FROZEN, text="50%"),
+                  **COMMON))
+    b.add(RowSpec(id="v/moved", test=passing(), vacuous="", **COMMON))
     got = {r.id: r for r in b.rows}
     assert got["v/ours"].status == sc.VACUOUS_STATUS and got["v/ours"].explanation.startswith("θ moved by")
     assert got["v/authors"].status == sc.AUTHORS_STATUS and got["v/authors"].judged_on == "authors' settings"
@@ -97,7 +100,8 @@ def test_a_vacuous_ratio_is_not_reproduced():
 
 def test_agreement_through_an_error_of_the_authors_code_is_counted_apart():
     b = Builder()
-    common = {**COMMON, "rule": "rounded", "kind": "closed form", "thesis": "≈ -422.616"}
+    common = {**{k: v for k, v in COMMON.items() if k not in ("ok", "relevance")}, "rule": "rounded",
+              "kind": "closed form", "thesis": "≈ -422.616"}
     b.add(RowSpec(id="e/error", ok=False, authors=AuthorsColumn(ok=True, error=True, text="-422.61600",
                                                                 note="Their J is 16 times the expectation."),
                   **common))
@@ -116,7 +120,7 @@ def test_the_status_rule_names_the_new_statuses():
 
 def test_kind_and_judged_interval_reach_the_files_and_the_page(tmp_path):
     b = Builder()
-    b.add(RowSpec(id="table-5.4/adaptive/improvement-ratio", ok=True, vacuous=FROZEN, interval=[41.8, 55.4],
+    b.add(RowSpec(id="table-5.4/adaptive/improvement-ratio", test=passing(), vacuous=FROZEN, interval=[41.8, 55.4],
                   interval_text="[41.8%; 55.4%]: 95% prediction interval for one run, 5 seeds", seeds=5, **COMMON))
     files = sc.write_scorecard(tmp_path, b.rows)
     row = json.loads(files["scorecard.json"].read_text())["rows"][0]
@@ -128,25 +132,33 @@ def test_kind_and_judged_interval_reach_the_files_and_the_page(tmp_path):
     assert table["judged_interval_text"].startswith("[41.8%; 55.4%]")
     assert sc.read_scorecard_json(files["scorecard.json"]) == b.rows
     page = sc.group_html(b.rows, "Section 5.3") + sc.summary_html(b.rows)
-    assert 'data-kind="one run"' in page and "95% prediction interval for one run, 5 seeds" in page
+    assert 'data-kind="one run"' in page and "p = 0.9 (fake, 5 seeds); detects" in page
     assert 'class="sc-status sc-vacuous"' in page
+    assert csv_row["test"] == "fake" and float(csv_row["p_value"]) == 0.9 and csv_row["state"] == "conclusive"
 
 
-def test_a_ratio_is_judged_within_one_update_of_our_seeds():
-    from safepg.thesis.scorecard.judged import one_run_ratio, ratio_interval
+def test_a_ratio_is_tested_within_half_an_update_of_its_print():
+    from safepg.thesis.scorecard.judged import ratio_test
 
-    # Five seeds at 100% over 100 iterations: a printed 98.99% (98 of 99 updates) is one update away.
-    row = {"improvement_ratio": seed_summary95([1.0] * 5), "iterations": 100.0, "seeds": 5}
-    assert ratio_interval(row) == pytest.approx([100 - 100 / 99, 100.0])
-    assert one_run_ratio(0.9899, row) and not one_run_ratio(0.9797, row)  # two updates away
-    assert one_run_ratio(0.5, {"improvement_ratio": seed_summary95([0.5]), "iterations": 9.0, "seeds": 1}) is None
+    # Five seeds at 100% over 100 iterations (n = 98 updates in the smaller count): a printed 98.99% lies
+    # half an update (0.51 points) and its last digit (0.005 points) from 100% less one update; the spread
+    # is the binomial one of 0.5 worsening updates in 491, 0.32 points.
+    row = {"improvement_ratio": {"values": [1.0] * 5}, "updates": [99] * 5}
+    test = ratio_test(0.9899, row)
+    n = 98
+    q = 0.5 / (n * 5 + 1)
+    assert test.resolution == pytest.approx(0.5 / n) and test.spread == pytest.approx(math.sqrt(q * (1 - q) / n))
+    assert test.distance == pytest.approx(1 - 0.98995 - 0.5 / n)
+    assert test.p_value == pytest.approx(2 * scipy_stats.t.sf(test.distance / (test.spread * math.sqrt(1.2)), 4))
+    assert ratio_test(1.0, row).p_value == 1.0  # 100% against 100% in every seed
+    assert ratio_test(0.5, {"improvement_ratio": {"values": [0.5]}, "updates": [9]}) is None  # one seed
 
 
 def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status(tmp_path):
     b = Builder()
-    b.add(RowSpec(id="f/authors", ok=True, vacuous=FROZEN, **COMMON,
-                  authors=AuthorsColumn(ok=True, text="53.06%", note="Their run.")))
-    b.add(RowSpec(id="f/clean", ok=True, **COMMON))
+    b.add(RowSpec(id="f/authors", test=passing(), vacuous=FROZEN, **COMMON,
+                  authors=AuthorsColumn(test=passing(), text="53.06%", note="Their run.")))
+    b.add(RowSpec(id="f/clean", test=passing(), **COMMON))
     flagged, clean = b.rows
     assert flagged.status == sc.AUTHORS_STATUS and flagged.no_information == FROZEN
     assert "agrees too, without information" in flagged.explanation and not clean.no_information
@@ -158,9 +170,9 @@ def test_a_column_that_agrees_without_information_is_flagged_whatever_the_status
 
 def test_the_chapters_count_sentence_names_every_status_with_rows():
     b = Builder()
-    b.add(RowSpec(id="c/ok", ok=True, **COMMON))
-    b.add(RowSpec(id="c/vacuous", ok=True, vacuous=FROZEN, **COMMON))
-    b.add(RowSpec(id="c/open", ok=False, **COMMON))
+    b.add(RowSpec(id="c/ok", test=passing(), **COMMON))
+    b.add(RowSpec(id="c/vacuous", test=passing(), vacuous=FROZEN, **COMMON))
+    b.add(RowSpec(id="c/open", test=failing(), **COMMON))
     assert sc.counts_text(b.rows) == ("3 printed results: 1 reproduced, 1 that agree without carrying information, "
                                       "1 open; in 1 of them one of our columns agrees with the print without "
                                       "information")

@@ -27,10 +27,13 @@ this test, like a prediction interval, does not tolerate). The measured rate com
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -219,6 +222,60 @@ def checks_from_dicts(data: Sequence[Mapping[str, Any]]) -> list[AlarmCheck]:
     return [AlarmCheck(**{**d, "interval": tuple(d["interval"])}) for d in data]
 
 
-__all__ = ["CONTROLS", "CURVE_CONFIG", "MEASURED", "NOISY_CONFIG", "NOMINAL", "PRINTED_RUNS", "RUNS_PER_TRIAL",
-           "TRIALS", "TRIAL_BUDGET", "AlarmCheck", "checks_from_dicts", "false_alarm_checks", "false_alarms",
-           "trial_runs"]
+# ------------------------------------------------------------------ stored with the book's runs
+#: The folder of the stored checks, inside the results folder.
+FOLDER = "false-alarms"
+#: What the checks are computed from: these modules' sources and the trial configurations' keys.
+_SOURCES = ("significance.py", "stats.py", "thesis/false_alarms.py", "thesis/seed_rule.py",
+            "thesis/scorecard/judged.py", "thesis/scorecard/verdicts.py")
+
+
+def checks_key(trials: int = TRIALS) -> str:
+    """SHA-256 (hex, 16 digits) of what the checks depend on: the rules' modules, the trials' configurations
+    (their keys hold the kernels' version) and the number of trials."""
+    package = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256(f"trials {trials}\n".encode())
+    for name in _SOURCES:
+        h.update(name.encode() + b"\n" + (package / name).read_bytes())
+    for config in {c.name: c for c, *_ in MEASURED.values()}.values():
+        h.update(f"config {config.name} {config.key()}\n".encode())
+    return h.hexdigest()[:16]
+
+
+def checks_path(root: Path, trials: int = TRIALS) -> Path:
+    """Where the checks of the present rules are stored under the results folder ``root``."""
+    return root / FOLDER / f"checks-{checks_key(trials)}.json"
+
+
+def false_alarms_stored(root: Path, trials: int = TRIALS, jobs: int = -1) -> list[AlarmCheck]:
+    """The checks of :func:`false_alarm_checks` for the present rules, read from ``root`` or computed and
+    stored there (atomically; the files of other rules are removed)."""
+    path = checks_path(root, trials)
+    if path.exists():
+        return checks_from_dicts(json.loads(path.read_text(encoding="utf-8")))
+    checks = false_alarm_checks(trials, jobs)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps([c.to_dict() for c in checks], indent=1) + "\n", encoding="utf-8")
+    tmp.replace(path)
+    for old in path.parent.glob("checks-*.json"):
+        if old != path:
+            old.unlink(missing_ok=True)
+    return checks
+
+
+def checks_table(checks: Sequence[AlarmCheck]) -> str:
+    """The checks as a Markdown table: each rule at each level, its false alarms, their rate with its 95%
+    Clopper-Pearson interval, whether the interval holds the nominal level, and our runs per trial."""
+    lines = ["| rule | run at | false alarms | rate [95% interval] | holds 5%? | our runs (mean) |",
+             "|---|---:|---:|---|:-:|---:|"]
+    for c in checks:
+        lines.append(f"| {c.rule} | {c.level:.0%} | {c.alarms} of {c.trials} | {c.rate:.1%} "
+                     f"[{c.interval[0]:.1%}; {c.interval[1]:.1%}] | {'yes' if c.holds else 'no'} | "
+                     f"{c.mean_seeds:.1f} |")
+    return "\n".join(lines)
+
+
+__all__ = ["CONTROLS", "CURVE_CONFIG", "FOLDER", "MEASURED", "NOISY_CONFIG", "NOMINAL", "PRINTED_RUNS",
+           "RUNS_PER_TRIAL", "TRIALS", "TRIAL_BUDGET", "AlarmCheck", "checks_from_dicts", "checks_key", "checks_path",
+           "checks_table", "false_alarm_checks", "false_alarms", "false_alarms_stored", "trial_runs"]

@@ -9,7 +9,11 @@ r"""What the book's chapters compute, computed before ``jupyter-book build``, wi
 - ``run_sweep(...)``: the cart-pole sweep's baseline searches (``SWEEP_SEEDS`` seeds), then
   ``cartpole-sweep``;
 - ``sweep_paths(...)``: the Table 5.1 sweep (its literal keyword arguments kept);
-- ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`).
+- ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`);
+- ``false_alarms_stored(...)``: the scorecard's false-alarm checks of its rules;
+
+and after the experiments, the scorecard's seed rule (:mod:`safepg.thesis.seed_rule`): the seeds its
+rows ask for beyond their experiments', computed the same way.
 
 Each is computed into the store the notebooks read (``results/`` beside ``book/``, their
 ``Path("..") / "results"``) by the very functions the notebooks call, with the same joblib
@@ -63,7 +67,8 @@ class Task:
 
     ``kind`` is ``"experiment"`` (``name`` in the registry, run for ``seeds`` seeds),
     ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``) or
-    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements).
+    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements) or ``"false-alarms"`` (the
+    scorecard's measured false alarms).
     """
 
     chapter: str
@@ -147,6 +152,8 @@ def chapter_requests(notebook: Path) -> list[Task]:
                                   options=_literal_keywords(call, ("jobs", "seeds", "budget"))))
             elif name == "measure_runs":
                 tasks.append(Task(chapter, "safety-mc", "safety-mc"))
+            elif name == "false_alarms_stored":
+                tasks.append(Task(chapter, "false-alarms", "false-alarms"))
     return tasks
 
 
@@ -521,6 +528,28 @@ def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: b
     return "computed"
 
 
+def prefetch_false_alarms(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
+                          tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
+    """The scorecard's false-alarm checks (:func:`safepg.thesis.false_alarms.false_alarms_stored`) for the
+    present rules."""
+    from safepg.thesis.false_alarms import checks_path, false_alarms_stored
+
+    stream = stream or sys.stdout
+    if checks_path(root).exists():
+        _say(stream, f"{task.name}: stored (the checks of the present rules)")
+        return "stored"
+    progress = Progress(task.name, 1, 0, 1.0, unit="checks", stream=stream, tty=tty, interval=interval,
+                        previous_s=previous_seconds(book, task.name))
+    try:
+        false_alarms_stored(root, jobs=jobs)
+        progress.advance(0, 1.0)
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
+    return "computed"
+
+
 def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
     """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute."""
     from joblib import effective_n_jobs
@@ -609,6 +638,8 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
             continue
         if t.kind == "table-5.1-sweep":
             done[t.name] = prefetch_sweep(t, root, **kw)
+        elif t.kind == "false-alarms":
+            done[t.name] = prefetch_false_alarms(t, root, jobs, **kw)
         else:
             done[t.name] = prefetch_safety(t, root, **kw)
     computed = sum(v == "computed" for v in done.values())

@@ -53,9 +53,13 @@ from safepg.thesis.scorecard.export import (
     TABLES,
     counts,
     counts_text,
+    family_numbers,
     headline_numbers,
     read_csv,
     read_scorecard_json,
+    row_id_of,
+    status_key,
+    statuses,
     write_scorecard,
 )
 from safepg.thesis.scorecard.links import BOOK, book_link
@@ -65,6 +69,7 @@ from safepg.thesis.scorecard.rows import (
     NEEDED,
     RANGE_VARIANTS,
     RUN_PAGES,
+    build_rows,
     scorecard,
 )
 from safepg.thesis.scorecard.rules import (
@@ -72,12 +77,14 @@ from safepg.thesis.scorecard.rules import (
     AUTHORS_STATUS,
     FROZEN_THETA,
     GROUPS,
+    INCONCLUSIVE_STATUS,
     JUDGED_ON,
     KIND_RULE,
     KINDS,
     NOTES,
     PRINTED,
     RATIO_POINTS,
+    RELEVANCE,
     RULES,
     STATUS_RULE,
     STATUSES,
@@ -94,13 +101,15 @@ from safepg.thesis.scorecard.rules import (
     within_points,
     within_rounding,
 )
+from safepg.thesis.scorecard.verdicts import CORRECTION, FDR_LEVEL, FLOOR_MARGIN
 
 __all__ = [
-    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CSV_COLUMNS", "CURVE_SHARE",
-    "FROZEN_THETA", "GROUPS", "JUDGED_ON", "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS",
-    "RATIO_POINTS", "RULES", "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS",
-    "VACUOUS_STATUS", "Note", "Row", "Status", "book_link", "counts", "counts_text", "group_html", "half_unit",
-    "headline_numbers", "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude", "read_csv",
-    "read_scorecard_json", "row_anchor", "scorecard", "summary_html", "within_points", "within_rounding",
-    "write_scorecard",
+    "AUTHORS_ERROR_STATUS", "AUTHORS_STATUS", "AUTHORS_VARIANTS", "BOOK", "CORRECTION", "CSV_COLUMNS",
+    "CURVE_SHARE", "FDR_LEVEL", "FLOOR_MARGIN", "FROZEN_THETA", "GROUPS", "INCONCLUSIVE_STATUS", "JUDGED_ON",
+    "KINDS", "KIND_RULE", "NEEDED", "NOTES", "PRINTED", "RANGE_VARIANTS", "RATIO_POINTS", "RELEVANCE", "RULES",
+    "RUN_PAGES", "STATUSES", "STATUS_RULE", "TABLES", "TABLE_DECIMALS", "THEORY_LABELS", "VACUOUS_STATUS", "Note",
+    "Row", "Status", "book_link", "build_rows", "counts", "counts_text", "family_numbers", "group_html",
+    "half_unit", "headline_numbers", "in_prediction", "intervals_overlap", "is_slip", "order_of_magnitude",
+    "read_csv", "read_scorecard_json", "row_anchor", "row_id_of", "scorecard", "status_key", "statuses",
+    "summary_html", "within_points", "within_rounding", "write_scorecard",
 ]

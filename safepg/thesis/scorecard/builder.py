@@ -188,6 +188,11 @@ def _status(ok: bool | None, spec: RowSpec, note: Note | None) -> tuple[Status, 
     return "open", judged_on
 
 
+def _number(x: float | None) -> float | None:
+    """A row's number as the files hold it: None where there is none (no test, or one without a p-value)."""
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
 def _state(v: ColumnVerdict | None) -> str:
     """A column's test within the family, in one word ("" without a test)."""
     if v is None:
@@ -269,12 +274,18 @@ class Builder:
             If a row's note is filled and quotes values the row does not give.
         """
         judged = [self._judged_spec(spec) for spec in self.specs]
-        family = [(i, side, t) for i, (spec, tests) in enumerate(zip(self.specs, judged))
-                  for side, t in tests.items() if t is not None]
+        tests = [(i, side, t) for i, (spec, columns) in enumerate(zip(self.specs, judged))
+                 for side, t in columns.items() if t is not None]
+        # A test with too few runs for its statistic (Hotelling's with no more runs than blocks) tests nothing:
+        # it is not in the family, and its column is inconclusive.
+        family = [(i, side, t) for i, side, t in tests if math.isfinite(t.p_value)]
         rejected, level, own = correct([t.p_value for _, _, t in family])
         verdicts: dict[tuple[int, str], ColumnVerdict] = {}
         for (i, side, t), r, o in zip(family, rejected, own):
             verdicts[(i, side)] = column_verdict(t, bool(r), level, float(self.specs[i].relevance or 0.0), float(o))
+        for i, side, t in tests:
+            if (i, side) not in verdicts:
+                verdicts[(i, side)] = column_verdict(t, False, level, float(self.specs[i].relevance or 0.0))
         return [self._row(spec, verdicts.get((i, "ours")), verdicts.get((i, "authors")))
                 for i, spec in enumerate(self.specs)]
 
@@ -313,7 +324,7 @@ class Builder:
             explanation = tests
         text = _explanation(ok if not random or ok else (None if ours_v is None else False), explanation, status,
                             judged_on, spec, note)
-        if random and status != INCONCLUSIVE_STATUS and tests:
+        if random and status not in (INCONCLUSIVE_STATUS, "reproduced") and tests:
             text = " ".join(t for t in (text, tests) if t)
         return Row(
             id=spec.id, group=spec.group, quantity=spec.quantity, where=spec.where, thesis=spec.thesis,
@@ -327,12 +338,12 @@ class Builder:
             judged_interval_text=a.interval_text if on_authors else spec.interval_text,
             judged_seeds=a.seeds if on_authors else spec.seeds, no_information=no_information,
             test=(spec.test or a.test).name if random and (spec.test or a.test) is not None else "",
-            p_value=None if ours_v is None else ours_v.p_value,
-            authors_p_value=None if theirs_v is None else theirs_v.p_value,
-            level=None if judged is None else judged.level,
+            p_value=_number(None if ours_v is None else ours_v.p_value),
+            authors_p_value=_number(None if theirs_v is None else theirs_v.p_value),
+            level=_number(None if judged is None else judged.level),
             detectable=None if judged is None or judged.rejected or not math.isfinite(judged.detectable)
             else judged.detectable,
-            relevance=spec.relevance if random else None, relevance_text=spec.relevance_text,
+            relevance=_number(spec.relevance) if random else None, relevance_text=spec.relevance_text,
             seeds_needed=None if ours_v is None else ours_v.seeds_needed,
             authors_seeds_needed=None if theirs_v is None else theirs_v.seeds_needed,
             test_text=tests, sources=list(spec.sources), authors_sources=list(a.sources),

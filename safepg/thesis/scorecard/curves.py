@@ -13,13 +13,9 @@ from typing import Any
 
 from safepg.learning import LearningRecord
 from safepg.thesis.curve_bands import (
-    FIGURES_51_52_HYPOTHESES,
     CurveScore,
     curve_holds,
     curve_scores,
-    figure55_spread,
-    figures51_52_hypotheses,
-    figures51_52_spread,
     outside_sentence,
 )
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
@@ -64,23 +60,6 @@ def _side(s: CurveScore) -> str:
     return "authors" if s.processing == "authors" or s.experiment in AUTHORS_SETTINGS else "ours"
 
 
-def hypotheses_sentence(tested: Mapping[str, Any]) -> str:
-    """The shares one curve of Figures 5.1-5.2 gave under each hypothesis tested, in one sentence."""
-    parts = [f"{h.label}, {tested[h.label]:.1%}" for h in FIGURES_51_52_HYPOTHESES if h.label in tested]
-    return "Tested, with the share of their curve inside our band: " + "; ".join(parts) + "."
-
-
-def spread_sentence(spread: Mapping[str, Any]) -> str:
-    """How one run's share scatters (:func:`~safepg.thesis.curve_bands.figures51_52_spread`), in one sentence."""
-    theirs = ", ".join(f"{v:.1%}" for v in spread["theirs"])
-    ours = spread["ours"]
-    runs = (f"their committed runs give {theirs} (run 1, the plotted one, first)" if len(spread["theirs"]) > 1
-            else f"their one committed run gives {theirs}")
-    return (f"Under their processing and settings, {runs}, and each of our {len(ours)} seeds against the band of "
-            f"the other {len(ours) - 1} gives {min(ours):.1%} to {max(ours):.1%}: one run's share scatters that "
-            "much under this rule.")
-
-
 def _curve_key(s: CurveScore) -> str:
     """The authors' curve a score belongs to: their runs of one Figure 5.3-5.4 curve count as one."""
     return s.curve.split("/run-")[0]
@@ -112,8 +91,6 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
         Loaded runs by experiment name (those of :data:`~safepg.thesis.curve_bands.CURVE_EXPERIMENTS`
         that are stored; a curve without runs gets no row).
     """
-    tested = {h["curve"]: h for h in figures51_52_hypotheses(records)}
-    spread = {(h["figure"], h["curve"]): h for h in figures51_52_spread(records) + figure55_spread(records)}
     grouped: dict[tuple[str, str], dict[str, list[CurveScore]]] = {}
     for s in curve_scores(records):
         grouped.setdefault((s.figure, _curve_key(s)), {}).setdefault(_side(s), []).append(s)
@@ -130,15 +107,11 @@ def curve_rows(b: Builder, records: Mapping[str, Mapping[str, Sequence[LearningR
             experiment=theirs["worst"].experiment, interval_text=theirs["band"], note=AUTHORS_NOTES.get(figure, ""))
         processed = theirs is not None and theirs["worst"].processing == "authors"
         label = "Under the authors' processing and settings, ours" if processed else "Under the authors' settings, ours"
+        # Where the curves part, described by our band (the test decides).
         remark = " ".join(f"{lab}: their curve {outside_sentence(c['worst'])}"
                           for lab, c in (("Ours", ours), (label, theirs))
                           if c is not None and not c["holds"])
-        still_open = not any(c is not None and c["holds"] for c in (ours, theirs))
         relevance = (ours or theirs or {}).get("relevance")
-        if still_open and figure in ("5.1", "5.2"):
-            remark += " " + hypotheses_sentence(tested[curve])
-        if still_open and (figure, curve) in spread:
-            remark += " " + spread_sentence(spread[(figure, curve)])
         runs = len(next(iter(sides.values())))  # their runs behind the curve (Figures 5.3-5.4: several)
         # What their curve is: under their processing, one run whatever the caption says.
         kind = (f"{theirs['worst'].kind}, which the caption calls averaged over 5 runs"

@@ -82,6 +82,56 @@ def headline_numbers(rows: Sequence[Row]) -> dict[str, float]:
     return out
 
 
+#: The glue keys of rows' statuses start with this (:func:`status_key`).
+STATUS_PREFIX = "status__"
+
+
+def status_key(row_id: str) -> str:
+    """The glue key under which a chapter quotes a row's status: ``status__`` and the row's id with ``__`` for
+    each ``/`` (``table-5.4/adaptive/upsilon`` -> ``status__table-5.4__adaptive__upsilon``)."""
+    return STATUS_PREFIX + row_id.replace("/", "__")
+
+
+def row_id_of(key: str) -> str:
+    """The row id a :func:`status_key` names.
+
+    Raises
+    ------
+    ValueError
+        If ``key`` is not a status key.
+    """
+    if not key.startswith(STATUS_PREFIX):
+        raise ValueError(f"key must start with {STATUS_PREFIX!r}, got {key!r}")
+    return key[len(STATUS_PREFIX):].replace("__", "/")
+
+
+def statuses(rows: Sequence[Row], row_ids: Iterable[str]) -> dict[str, str]:
+    """The statuses of ``row_ids`` by :func:`status_key`, for a chapter to glue: its verdict words then come
+    from the scorecard, never from its prose.
+
+    Raises
+    ------
+    KeyError
+        If a row id is not among ``rows``.
+    """
+    by_id = {r.id: r for r in rows}
+    missing = [i for i in row_ids if i not in by_id]
+    if missing:
+        raise KeyError(f"no scorecard row {missing}")
+    return {status_key(i): by_id[i].status for i in row_ids}
+
+
+def family_numbers(rows: Sequence[Row]) -> dict[str, float]:
+    """The family of tests the correction covers, in the numbers the scorecard page quotes: ``n_random`` (rows
+    judged on runs), ``n_tests`` (their columns with a test), ``n_rejected``, ``level`` (the threshold a test
+    not rejected faces, :math:`(R + 1)q/m`) and ``fdr`` (the false discovery rate, :math:`q`)."""
+    random = [r for r in rows if r.test]
+    states = [s for r in random for s in (r.state, r.authors_state) if s]
+    levels = [r.level for r in random if r.level is not None and "rejected" not in (r.state, r.authors_state)]
+    return {"n_random": len(random), "n_tests": len(states), "n_rejected": sum(s == "rejected" for s in states),
+            "level": max(levels) if levels else float("nan"), "fdr": FDR_LEVEL}
+
+
 #: Columns of the CSV files (``fields`` go to the table files as their own columns).
 CSV_COLUMNS = ("id", "group", "quantity", "where", "kind", "thesis", "ours", "difference", "status", "judged_on",
                "rule", "test", "p_value", "authors_p_value", "level", "detectable", "relevance", "relevance_text",

@@ -311,38 +311,33 @@ class Note:
         return fill(self.text, values._asdict())
 
 
-#: The authors' curves of Figures 5.1 and 5.2 that leave our band under both processings.
+#: The authors' curves of Figures 5.1 and 5.2, where their runs differ from ours under both settings.
 _FIGURES_5_1_5_2 = Note(
-    "Open: neither as the thesis's text has it (the J of the policy in use, a five-run mean) nor as the authors "
-    "made it (their run 1 through plots/scaleData.m, one update behind, under their settings) does 90% of their "
-    "curve lie in our band; the hypotheses tested and the share each gave follow. What is missing: a setting "
-    "the audit has not found, or runs enough to tell one from noise: under this rule one run's share scatters "
-    "widely, as their other runs and our own seeds show (last sentence).", "lqg1d", "Figures 5.1 and 5.2",
-    explains=False)
+    "Open: their five runs differ from ours both as the thesis's text has them (the J of the policy in use) and "
+    "as the authors made them (through plots/scaleData.m, one update behind, under their settings). What is "
+    "missing: a setting the audit has not found.", "lqg1d", "Figures 5.1 and 5.2", explains=False)
 
-#: Figure 5.5's coordinate curve, which leaves our band under both processings.
+#: Figure 5.5's coordinate curve, where their run differs from ours under both processings.
 _FIGURE_5_5_COORDINATE = Note(
-    "Open: their coordinate run lies above our seeds' band over part of its course, read as the thesis's text "
-    "reads it (each batch's J held at their batch ends) and as their plot script made it (plots/scaleData.m, one "
-    "update behind), which differ by about a hundredth of J at most; their step sizes lie in our band (Figure 5.6). "
-    "What is missing: their other runs (one run per step rule is committed), to tell a run ahead of ours from a "
-    "difference of the method.", "lqg2d", "Figures 5.5 and 5.6", explains=False)
+    "Open: their coordinate run differs from ours, read as the thesis's text reads it (each batch's J held at "
+    "their batch ends) and as their plot script made it (plots/scaleData.m, one update behind), which differ by "
+    "about a hundredth of J at most. What is missing: their other runs (one run per step rule is committed), to "
+    "tell a run ahead of ours from a difference of the method.", "lqg2d", "Figures 5.5 and 5.6", explains=False)
 
 #: Explanations and notes, by row id or id prefix (``"table-5.1/"`` covers every cell).
 #: ``{...}`` fields are filled from the note's measured values, which the row gives (:meth:`Note.fill`).
 NOTES: dict[str, Note] = {
     "table-5.1/": Note(
-        "Open: neither from the printed θ0 = {printed_theta0} nor from the authors' θ0 = {authors_theta0} does our "
-        "prediction interval for one run hold the printed value; what is missing: the authors' other runs (one run "
-        "per cell is committed) to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False,
+        "Open: the test rejects the printed value both from the printed θ0 = {printed_theta0} and from the "
+        "authors' θ0 = {authors_theta0}; what is missing: the authors' other runs (one run per cell is committed) "
+        "to tell a setting from one run's noise.", "lqg1d", "Table 5.1", explains=False,
         measured=Theta0s),
     "table-5.1/tail": Note(
         "The print is the authors' own run, and a rare one of the process ours follows: of our {runs} runs under "
         "their settings (table-5.1-authors-tail) {at_least} reach it; it lies {z:.1f} standard deviations of one "
-        "run above our mean {mean}, beyond our prediction interval for one run from those runs, {interval}. An "
+        "run above our mean {mean} (our 95% prediction interval for one run from those runs: {interval}). An "
         "update improves J while θ moves towards θ* = {theta_star:.4f}, so the ratio is set mostly by when θ "
-        "crosses it: theirs after {crossing_theirs} updates, ours after {crossing_ours}. With 24 cells, each held "
-        "to a 95% interval, some cell outside is expected (1 - 0.95^24 = 71%).", "lqg1d", "Table 5.1",
+        "crosses it: theirs after {crossing_theirs} updates, ours after {crossing_ours}.", "lqg1d", "Table 5.1",
         measured=TailRuns),
     "table-5.2/theoretical-range": Note(
         "Open: {range_rows}, and the authors' own five runs give the printed value (beside). What is missing is "

@@ -165,10 +165,10 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
               rule="prediction", kind="one run", page="lqg1d", heading="Table 5.1", thesis_value=thesis,
               ours_value=mean, ours_ci95=ci, seeds=r["seeds"], expected_seeds=printed.seeds,
               interval=ratio_interval(r), interval_text=ratio_text(r), vacuous=frozen(r.get("theta_moved")),
-              authors=replace(a_col, note=f"From the printed θ0 = {T51_PRINTED_THETA0:g} the printed value is outside "
-                              f"our prediction interval for one run; from the authors' θ0 = {AUTHORS_T51_THETA0:g} "
-                              "(where all 24 of their output files start), counted as they counted (strict increases "
-                              "over 10^6/N - 1 updates), it is inside." + recon_text),
+              authors=replace(a_col, note="Reproduced from the authors' θ0 = "
+                              f"{AUTHORS_T51_THETA0:g} (where all 24 of their output files start), counted as they "
+                              "counted (strict increases over 10^6/N - 1 updates); from the printed θ0 = "
+                              f"{T51_PRINTED_THETA0:g} the test rejects the printed value." + recon_text),
               slip_note=slip_sentence(out, printed_text, lambda v: f"{v:.4g}%", scale=100),
               fields={"sigma": sigma, "N": n, "alpha": alpha, "theta0": c.theta0[0]}, output=out,
               note_id="table-5.1/tail" if key in (tail or {}) else None, note_values=(tail or {}).get(key, starts)))
@@ -254,7 +254,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
               expected_seeds=variant.seeds if theoretical and variant is not None else exp.seeds, interval=ci,
               interval_text=ci_judged(ci, fmt, seeds),
               authors=a_col if not guarded else replace(a_col, note=(
-                  "Lemma 4.3.3's range (6400 here) gives an interval that misses the printed one; the authors' "
+                  "With Lemma 4.3.3's range (6400 here) the test rejects the printed mean; the authors' "
                   "settings reproduce it: their formula for the range, 2 M_φ Ā |A| R / (σ² (1 - γ)) = 1280 "
                   "(lqg/lqg_adabatch.py@af36577:50-52), and their step taken even when ε ≥ abs(g) "
                   f"(lqg/lqg_adabatch.py@af36577:247-257), which this range meets on the first batch. With "

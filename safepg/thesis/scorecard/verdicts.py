@@ -105,9 +105,13 @@ def column_verdict(test: Test, rejected: bool, level: float, relevance: float, o
     """A column's test judged: rejected, or not rejected and conclusive when its detectable difference at
     ``level`` is within ``relevance``, else inconclusive with the runs it would need."""
     p = test.p_value
+    if not math.isfinite(p):  # too few runs for the statistic: it detects nothing yet
+        return ColumnVerdict(p, False, level, math.inf, False, seeds_for(test, level, relevance, block, SEEDS_LIMIT)
+                             if relevance > 0 else None, test.seeds)
     detectable = test.detectable_difference(level)
     floor = test.detectable_difference(level, math.inf)
-    held = max(relevance, FLOOR_MARGIN * floor) if math.isfinite(floor) else relevance
+    # An exact claim (relevance 0: a parameter that never moves) is held to exactness, whatever the noise.
+    held = max(relevance, FLOOR_MARGIN * floor) if relevance > 0 and math.isfinite(floor) else relevance
     enough = bool(detectable <= held * (1 + 1e-12))
     needed = None if enough else seeds_for(test, level, held, block, SEEDS_LIMIT)
     return ColumnVerdict(p, rejected, own_level if rejected else level, detectable, enough and not rejected, needed,
