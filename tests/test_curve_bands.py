@@ -199,18 +199,52 @@ def test_figures_51_52_under_the_authors_processing() -> None:
 
 
 def test_hypotheses_and_spread_of_figures_51_52() -> None:
+    """Our "seeds" are their runs 2-5; their run 1, held out, is scored under their processing against the
+    band of those four, recomputed here from scipy's t quantile (an independent band)."""
     from safepg.thesis.curve_bands import FIGURES_51_52_HYPOTHESES, figures51_52_hypotheses, figures51_52_spread
 
     key, name = ("gpomdp", "chebyshev", False, 0.75), "gpomdp-chebyshev-delta=0.75"
     runs = authors.table52_runs()[key]
-    # Our five "seeds" are their five runs: run 1 is then inside the band of runs 1-5 under their processing.
-    recs = [_fake(r["N"].copy(), np.append(r["J"], r["J"][-1])) for r in runs]
+    recs = [_fake(r["N"].copy(), np.append(r["J"], r["J"][-1])) for r in runs[1:]]
     records = {"table-5.2": {name: recs}, "figures-5.1-5.2-authors": {name: recs}}
     rows = {h["curve"]: h for h in figures51_52_hypotheses(records)}
     assert set(rows[name]) == {"curve"} | {h.label for h in FIGURES_51_52_HYPOTHESES}
-    assert rows[name][FIGURES_51_52_HYPOTHESES[-1].label] == 1.0  # their run 1 is one of the seeds
     assert math.isnan(rows["gpomdp-chebyshev-delta=0.95"][FIGURES_51_52_HYPOTHESES[0].label])  # no runs
+    x, theirs = authors.grid_curve(runs[0]["N"], runs[0]["J"])
+    ours = np.array([authors.grid_curve(r["N"], r["J"])[1] for r in runs[1:]])
+    h = scipy.stats.t.ppf(0.975, 3) * ours.std(axis=0, ddof=1) * math.sqrt(1 + 1 / 4)
+    written = authors.figure51_52_curves()[key]["J"]  # their plotted curve: run 1, written with 6 decimals
+    assert np.allclose(written, theirs, atol=5e-7)
+    inside = np.abs(written - ours.mean(axis=0)) <= h + 5e-7
+    expected = inside.mean()
+    assert 0.05 < expected < 0.999  # a held-out run: neither everywhere inside nor nowhere
+    assert rows[name][FIGURES_51_52_HYPOTHESES[-1].label] == pytest.approx(expected, abs=2 / x.size)
     spread = {s["curve"]: s for s in figures51_52_spread(records)}
-    assert set(spread) == {name} and len(spread[name]["theirs"]) == 5 and len(spread[name]["ours"]) == 5
-    assert spread[name]["theirs"] == [1.0] * 5  # each of their runs is one of the seeds
-    assert all(0.0 <= v <= 1.0 for v in spread[name]["ours"])
+    assert set(spread) == {name} and len(spread[name]["theirs"]) == 5 and len(spread[name]["ours"]) == 4
+    assert spread[name]["theirs"][0] == pytest.approx(expected, abs=2 / x.size)
+
+
+def test_curve_test_two_samples_and_one_run() -> None:
+    """The curve's test takes block means over the range every curve covers: their five runs against ours by
+    the permutation test, one run by Hotelling's test; a shift of theirs by many standard deviations is found
+    (the smallest p of 5 against 10), the same process is not."""
+    from safepg.significance import CurvePredictionTest, PermutationTest
+    from safepg.thesis.curve_bands import curve_test
+
+    rng = np.random.default_rng(3)
+    x = np.arange(1, 301, dtype=float)
+    base = -50 + 40 * (1 - np.exp(-x / 60))
+
+    def runs(n: int, shift: float = 0.0) -> np.ndarray:
+        return base + shift + rng.normal(0, 0.5, (n, 1)) + rng.normal(0, 0.05, (n, x.size))
+
+    ours = runs(10)
+    ours[:, 280:] = np.nan  # a run that ended early: the range stops where every curve has a value
+    same, y_range, x_range = curve_test(x, runs(5), ours)
+    assert isinstance(same, PermutationTest) and same.p_value > 0.01 and x_range == (1.0, 280.0)
+    moved, *_ = curve_test(x, runs(5, shift=5.0), ours)
+    assert moved.p_value == pytest.approx(1 / 3003)
+    one, *_ = curve_test(x, runs(1, shift=5.0)[0], ours)
+    assert isinstance(one, CurvePredictionTest) and one.p_value < 0.05
+    assert y_range[1] - y_range[0] == pytest.approx(40 * (np.exp(-1 / 60) - np.exp(-280 / 60)), abs=3.0)
+    assert curve_test(x, runs(5), ours[:1])[0] is None  # one run of ours: no test
