@@ -406,10 +406,10 @@ def _welch_df(a: float, b: float, k: float, n: int) -> float:
 
 @dataclass(frozen=True)
 class WelchTest:
-    r"""A printed mean over :math:`n` runs with its two-sided 95% interval, against :math:`k` runs of ours.
+    r"""A printed mean over :math:`n` runs with its two-sided interval, against :math:`k` runs of ours.
 
-    The printed interval :math:`\bar y \pm h` gives the other sample's standard deviation,
-    :math:`s_y = h\sqrt n / t_{0.975,\,n-1}`; Welch's statistic is
+    The printed interval :math:`\bar y \pm h`, at level :math:`1 - a`, gives the other sample's standard
+    deviation, :math:`s_y = h\sqrt n / t_{1 - a/2,\,n-1}`; Welch's statistic is
 
     .. math:: T = \frac{\max(0, |\bar x - \bar y| - r)}{\sqrt{s_x^2/k + s_y^2/n}},
 
@@ -420,13 +420,15 @@ class WelchTest:
     ----------
     printed_mean : float
     printed_interval : (float, float)
-        The printed 95% interval of the mean (either order of ends).
+        The printed interval of the mean (either order of ends).
     runs : int
         The printed mean's runs :math:`n` (>= 2).
     values : sequence of float
         Our runs' values (at least two).
     resolution : float
         :math:`r`, >= 0.
+    interval_level : float
+        The level :math:`1 - a` the printed interval was computed at (what it is, not what it is called).
 
     Raises
     ------
@@ -441,10 +443,12 @@ class WelchTest:
     runs: int
     values: tuple[float, ...]
     resolution: float = 0.0
+    interval_level: float = 0.95
     mean: float = field(init=False)
     sd: float = field(init=False)
 
     def __post_init__(self) -> None:
+        _check_level(self.interval_level)
         lo, hi = sorted(float(v) for v in self.printed_interval)
         if not all(math.isfinite(v) for v in (lo, hi, self.printed_mean)):
             raise ValueError(f"printed_mean and printed_interval must be finite, got {self.printed_mean!r}, "
@@ -467,9 +471,9 @@ class WelchTest:
 
     @property
     def printed_sd(self) -> float:
-        r""":math:`s_y = h\sqrt n / t_{0.975,\,n-1}`."""
+        r""":math:`s_y = h\sqrt n / t_{1 - a/2,\,n-1}`."""
         lo, hi = self.printed_interval
-        return (hi - lo) / 2 * math.sqrt(self.runs) / t_critical(self.runs - 1, 0.05)
+        return (hi - lo) / 2 * math.sqrt(self.runs) / t_critical(self.runs - 1, round(1 - self.interval_level, 12))
 
     def _variances(self, seeds: float) -> tuple[float, float]:
         return self.sd**2 / seeds, self.printed_sd**2 / self.runs

@@ -13,11 +13,13 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from safepg import portable
 from safepg.learning import LearningRecord
 from safepg.options import Adaptive, FixedStep, Vanilla
 from safepg.runner import RunConfig
 from safepg.significance import Test, WelchTest
 from safepg.stats import prediction_interval95
+from safepg.thesis import authors as authors_tables
 from safepg.thesis.experiments import AUTHORS_T51_THETA0, T51_PRINTED_THETA0, Experiment, method_of
 from safepg.thesis.scorecard import outputs
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
@@ -64,6 +66,10 @@ def _points(v: float) -> str:
 
 #: Table 5.2's means are over this many runs of the authors ("All results are averaged over 5 runs").
 T52_PRINTED_RUNS = 5
+#: The level of Table 5.2's printed intervals as the authors computed them: their plot script's
+#: ``tinv([0.05, 0.95], n - 1)``, a 90% interval the thesis prints as 95%
+#: (:func:`safepg.thesis.authors.truncated_average`); it gives their runs' spread.
+T52_PRINTED_LEVEL = 0.90
 #: The relevance of an improvement ratio, and its words.
 RATIO_RELEVANCE = RELEVANT_SHARE
 RATIO_RELEVANCE_TEXT = relevance_text("ratio", RATIO_RELEVANCE, _points)
@@ -177,16 +183,20 @@ def _table_5_1_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any], printed
 def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
                     variant: Experiment | None, variant_rep: Mapping[str, Any] | None,
                     authors: Experiment | None = None, authors_rep: Mapping[str, Any] | None = None,
-                    settings: Experiment | None = None, settings_rep: Mapping[str, Any] | None = None) -> None:
+                    settings: Experiment | None = None, settings_rep: Mapping[str, Any] | None = None,
+                    records: Mapping[str, Mapping[str, Sequence[LearningRecord]]] | None = None) -> None:
     """Table 5.2 row by row. The two theoretical-range rows (Hoeffding and Bernstein without the
     empirical range) are judged on Lemma 4.3.3's range as printed (``variant``), then on the
     authors' settings: their formula for the range, 2 M_phi A_bar abs(A) R / (sigma^2 (1 - gamma))
     = 1280, which ``exp`` runs, and their step taken even when eps >= abs(g) (``authors``,
     ``table-5.2-authors``; without it, ``exp`` stands for the authors' settings). The other rows'
     authors' settings are ``settings`` (``figures-5.1-5.2-authors``: N_min and N_max from their run
-    files, the step taken even when eps >= abs(g))."""
+    files, the step taken even when eps >= abs(g)). A printed interval is read as the 90% interval it is
+    (:data:`T52_PRINTED_LEVEL`); under the authors' settings our runs (``records``) are averaged over their
+    script's window too."""
     dec = TABLE_DECIMALS["table-5.2"]
     fmt = lambda x: num(x, dec)  # noqa: E731
+    authors_t52 = authors_tables.table_5_2()
     lemma = {}
     for vc, vr in zip(variant.configs if variant else (), (variant_rep or {}).get("configs", [])):
         if method_of(vc, Adaptive).error.theoretical_range is None:
@@ -205,10 +215,18 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         out = outputs.table_5_2(key)
         printed_text = f"{th['upsilon_bar']:.{dec}f}"
 
-        def welch(row: Mapping[str, Any] | None, th: Mapping[str, Any] = th, text: str = printed_text) -> Test | None:
-            values = (row or {}).get("upsilon_bar", {}).get("values") or []
+        def welch(row: Mapping[str, Any] | None, th: Mapping[str, Any] = th, text: str = printed_text,
+                  values: Sequence[float] | None = None) -> Test | None:
+            values = values if values is not None else (row or {}).get("upsilon_bar", {}).get("values") or []
             return None if len(values) < 2 else WelchTest(th["upsilon_bar"], tuple(th["ci95"]), T52_PRINTED_RUNS,
-                                                           tuple(values), half_unit(text))
+                                                           tuple(values), half_unit(text), T52_PRINTED_LEVEL)
+
+        def truncated(exp_name: str, key: tuple[str, str, bool, float] = key, name: str = c.name) -> list[float]:
+            """Ours under the authors' settings averaged as their script averaged theirs: over the first T
+            iterations of each run, T the shortest of their runs (plots/lqg.m)."""
+            window = authors_t52.get(key, {}).get("T")
+            return [portable.fsum_mean(r.J_hat[:window], weights=r.batch_size[:window])
+                    for r in (records or {}).get(exp_name, {}).get(name, [])] if window else []
 
         test, source = welch(r), f"{exp.name}/{c.name}"
         seeds, a_col, note_id, guarded, range_runs = r["seeds"], AuthorsColumn(), None, "", None
@@ -220,7 +238,7 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
             if authors is not None:
                 a_mean, a_ci = _mean_ci(ar["upsilon_bar"]) if ar else (None, None)
                 a_col = _authors(authors, ar["seeds"] if ar else 0, a_mean, a_ci,
-                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", test=welch(ar),
+                                 f"{fmt(a_mean)}{ci_text(a_ci, fmt)}", test=welch(ar, values=truncated(authors.name)),
                                  interval=a_ci, interval_text=ci_judged(a_ci, fmt, ar["seeds"] if ar else None),
                                  sources=(f"{authors.name}/{c.name}",))
             else:
@@ -235,7 +253,8 @@ def _table_5_2_rows(b: Builder, exp: Experiment, rep: Mapping[str, Any],
         elif settings is not None and (sr := _report_row(settings_rep, c.name)) is not None:
             s_mean, s_ci = _mean_ci(sr["upsilon_bar"])
             a_col = replace(_authors(settings, sr["seeds"], s_mean, s_ci, f"{fmt(s_mean)}{ci_text(s_ci, fmt)}",
-                                     test=welch(sr), interval=s_ci, interval_text=ci_judged(s_ci, fmt, sr["seeds"]),
+                                     test=welch(sr, values=truncated(settings.name)), interval=s_ci,
+                                     interval_text=ci_judged(s_ci, fmt, sr["seeds"]),
                                      sources=(f"{settings.name}/{c.name}",)),
                             note="Reproduced with the authors' settings: N_min and N_max from their run files' "
                                  "headers (lqg/lqg_adabatch.py@eb78917:161) and the step taken even when ε ≥ "
@@ -659,7 +678,7 @@ def run_rows(b: Builder, exps: Mapping[str, Experiment], reps: Mapping[str, Mapp
                     exps.get("table-5.1-authors-tail"), reps.get("table-5.1-authors-tail"))
     _table_5_2_rows(b, exps["table-5.2"], reps["table-5.2"], exps.get(range_variant or ""),
                     reps.get(range_variant or ""), exps.get("table-5.2-authors"), reps.get("table-5.2-authors"),
-                    exps.get("figures-5.1-5.2-authors"), reps.get("figures-5.1-5.2-authors"))
+                    exps.get("figures-5.1-5.2-authors"), reps.get("figures-5.1-5.2-authors"), recs)
     _step_rows(b, rid="section-5.1/step-order", group="Section 5.1", where="Section 5.1 (Figures 5.1-5.4)",
                quantity="step size of Algorithm 4.1, every Table 5.2 configuration", recs=recs["table-5.2"],
                names=[c.name for c in exps["table-5.2"].configs], exponent=PRINTED["lqg1d_step_order"], page="lqg1d",
