@@ -45,6 +45,10 @@ AUTHORS_NOTES = {
            "unguarded steps, their coordinate 'vanilla'.",
 }
 AUTHORS_NOTES["5.8"] = AUTHORS_NOTES["5.7"]
+AUTHORS_NOTES["5.3"] = AUTHORS_NOTES["5.4"] = (
+    "Reproduced with the authors' settings: N_min and N_max from each run's header and their step taken after "
+    "the first batch whatever ε is (lqg/lqg_adabatch.py@eb78917:212-222), as figures-5.1-5.2-authors runs, and for "
+    "the theoretical-range rows their range 1280 with that step (table-5.2-authors).")
 AUTHORS_NOTES["5.5"] = (
     "Reproduced as the authors' plot script made it: their run through plots/scaleData.m@4ff60e7:1-11 (at x, the J "
     "of the policy of the last batch ended before x − 1000), and each of our runs likewise.")
