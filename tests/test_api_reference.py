@@ -23,6 +23,8 @@ import pytest
 import yaml
 from script_module import load
 
+from conftest import skip_or_fail
+
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "book" / "api.md"
 #: The modules the reference must cover; others (safepg.options, safepg.tasks) may be added.
@@ -133,7 +135,7 @@ def built_page(tmp_path_factory: pytest.TempPathFactory) -> str:
     """book/api.md built alone with the book's configuration; its HTML."""
     jb = Path(sys.executable).with_name("jupyter-book")
     if not jb.exists() and shutil.which("jupyter-book") is None:
-        pytest.skip("jupyter-book is not installed")
+        skip_or_fail("jupyter-book is not installed: run `make setup` (it is pinned in requirements.txt)")
     book = tmp_path_factory.mktemp("apibook")
     config = yaml.safe_load((ROOT / "_config.yml").read_text(encoding="utf-8"))
     # The chapters are left out: nothing to execute, and only this page's warnings count.

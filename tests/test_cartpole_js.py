@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 import pytest
 from test_learner2d_js import (
-    NODE,
     RTOL,
     check_updates,
     close_to_scale,
@@ -40,6 +39,7 @@ from test_learner2d_js import (
     write_section,
 )
 
+from conftest import require_node
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole, step_dynamics
 from safepg.learning import learn
@@ -50,6 +50,7 @@ from safepg.thesis.experiments import AUTHORS_DOUBLED
 from safepg.thesis.explorers.js_tasks import cartpole_task_data
 from safepg.thesis.explorers.option_names import learner_options
 
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 AUTHORS = CartPole.thesis_doubled(**AUTHORS_DOUBLED)  # 2 m pole, m l = 0.05, 12 deg, gamma 1 (0.9 in c)
 THESIS = CartPole.thesis_doubled()
 THETA_STAR = cartpole_theta_star()
@@ -59,7 +60,7 @@ def test_task_data_is_the_javascript_default():
     path = learner_file(Path(tempfile.mkdtemp()))
     script = (f"const L = require({json.dumps(str(path))}); console.log(JSON.stringify([L.cartpoleTask({{}}),"
               f" L.cartpoleTask({json.dumps(cartpole_task_data(AUTHORS))})]))")
-    default, authors = json.loads(subprocess.run([NODE, "-e", script], capture_output=True, text=True,
+    default, authors = json.loads(subprocess.run([require_node(), "-e", script], capture_output=True, text=True,
                                                  check=True).stdout)
     assert default == {**cartpole_task_data(CartPole()), "actionSpaceVolume": None}
     assert authors == cartpole_task_data(AUTHORS)

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 from importlib import resources
 
 import numpy as np
 import pytest
 
+from conftest import require_node
 from safepg.bounds import (
     ErrorBound,
     bernstein,
@@ -38,13 +38,12 @@ from safepg.meta import (
 )
 from safepg.thesis.explorers.component import static_text
 
-NODE = shutil.which("node")
-pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 
 
 def run_js(expr_cases: list[str]) -> list:
     script = static_text("lib.js") + "\nconsole.log(JSON.stringify([" + ",".join(expr_cases) + "]));"
-    out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
+    out = subprocess.run([require_node(), "-e", script], capture_output=True, text=True, check=True).stdout
     return json.loads(out)
 
 
@@ -59,7 +58,7 @@ def test_static_sources_parse(tmp_path):
             src = f"(function (p, data, lib) {{{src}}});"
         path = tmp_path / name
         path.write_text(src, encoding="utf-8")
-        proc = subprocess.run([NODE, "--check", str(path)], capture_output=True, text=True)
+        proc = subprocess.run([require_node(), "--check", str(path)], capture_output=True, text=True)
         assert proc.returncode == 0, (name, proc.stderr)
 
 

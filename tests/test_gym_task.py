@@ -16,7 +16,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-gym = pytest.importorskip("gymnasium")
+from conftest import import_or_fail
+
+gym = import_or_fail("gymnasium")
 from gymnasium import spaces  # noqa: E402
 
 from safepg.definition import UnnamedError  # noqa: E402

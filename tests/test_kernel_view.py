@@ -13,7 +13,9 @@ from typing import Any
 
 import pytest
 
-pytest.importorskip("ipywidgets")
+from conftest import import_or_fail
+
+import_or_fail("ipywidgets")
 
 from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider  # noqa: E402
 from safepg.thesis.explorers.curves import lqg_explorer, upsilon_explorer  # noqa: E402

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 import tempfile
 from dataclasses import replace
@@ -31,6 +30,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from conftest import require_node
 from safepg.bounds import error_bound
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
@@ -42,8 +42,7 @@ from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
 from safepg.thesis.explorers.option_names import learner_options
 
-NODE = shutil.which("node")
-pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 RTOL = 1e-12
 ROOT = Path(__file__).resolve().parents[1]
 AGREEMENT = ROOT / "benchmarks" / "js_learner_agreement.md"
@@ -103,7 +102,7 @@ def run_node(request: dict[str, Any]) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as d:
         harness = Path(d) / "harness.js"
         harness.write_text(HARNESS)
-        proc = subprocess.run([NODE, str(harness), str(learner_file(Path(d)))], input=json.dumps(request),
+        proc = subprocess.run([require_node(), str(harness), str(learner_file(Path(d)))], input=json.dumps(request),
                               capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)
@@ -195,8 +194,9 @@ def test_task_data_matches_the_javascript_helper():
     assert part["J"][0] is not None and len(part["c"]) == len(part["Jhat"]) == 2
     assert got["driver"][-1][0]["done"] and len(got["driver"][0][0]["theta0"]) == 4
     # safepgLearner.THESIS_2D is LQG.thesis_2d()
-    js = subprocess.run([NODE, "-e", f"const L=require({json.dumps(str(learner_file(Path(tempfile.mkdtemp()))))});"
-                                     "console.log(JSON.stringify([L.THESIS_2D, L.lqgTask({dim: 2, gamma: 0.9})]))"],
+    learner = json.dumps(str(learner_file(Path(tempfile.mkdtemp()))))
+    script = f"const L=require({learner});console.log(JSON.stringify([L.THESIS_2D, L.lqgTask({{dim: 2, gamma: 0.9}})]))"
+    js = subprocess.run([require_node(), "-e", script],
                         capture_output=True, text=True, check=True)
     thesis, ours = json.loads(js.stdout)
     assert thesis == lqg_task_data(LQG.thesis_2d())

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 import tempfile
 from importlib import resources
@@ -31,6 +30,7 @@ import pytest
 from scipy import stats
 from test_learner2d_js import replay_draws, save, table, welch_rows
 
+from conftest import require_node
 from safepg.bounds import (
     ErrorBound,
     error_bound,
@@ -54,14 +54,13 @@ from safepg.thesis.explorers.live_learner import (
 )
 from safepg.thesis.explorers.option_names import learner_options
 
-NODE = shutil.which("node")
 # Node requires it by path: the learner as the page loads it, its files concatenated.
 STATIC = Path(str(resources.files("safepg.thesis.explorers").joinpath("static", "learner.js")))
 #: The page half as the page loads it: the runs' worker and thinning (live_jobs.js), then live_page.js.
 PAGE = [str(STATIC.with_name("live_jobs.js")), str(STATIC.with_name("live_page.js"))]
 LEARNER = Path(tempfile.mkdtemp()) / "learner_all.js"
 LEARNER.write_text(learner_js())
-pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 RTOL = 1e-12
 
 # Reads one JSON request from stdin and answers with JSON on stdout. Float64 arrays too large
@@ -135,7 +134,7 @@ def run_node(request: dict[str, Any]) -> dict[str, Any]:
     with tempfile.NamedTemporaryFile("w", suffix=".js", delete=False) as f:
         f.write(HARNESS)
     try:
-        proc = subprocess.run([NODE, f.name, str(LEARNER)], input=json.dumps(request), capture_output=True,
+        proc = subprocess.run([require_node(), f.name, str(LEARNER)], input=json.dumps(request), capture_output=True,
                               text=True, check=False)
     finally:
         Path(f.name).unlink()
@@ -183,8 +182,8 @@ def one_d_runs(cfgs: list[dict[str, Any]]) -> list[list[Any]]:
               "          r.rec.theta[r.rec.theta.length - 1],"
               "          JSON.stringify(th) === JSON.stringify(r.rec.theta.slice(1))];"
               "}); console.log(JSON.stringify(out));")
-    proc = subprocess.run([NODE, "-e", script, json.dumps([task_data(), cfgs])], capture_output=True, text=True,
-                          check=True)
+    proc = subprocess.run([require_node(), "-e", script, json.dumps([task_data(), cfgs])], capture_output=True,
+                          text=True, check=True)
     return json.loads(proc.stdout)
 
 
