@@ -39,7 +39,8 @@ pos = st.floats(min_value=1e-2, max_value=1e2, allow_nan=False)
 
 
 def test_penalty_constant_by_hand():
-    # R = 4, M_phi = 2, |A| = 4, gamma = 0.9, sigma = 1 (SETTINGS.md)
+    # LQG.thesis_1d() with sigma = 1: R = (b_s^2 + b_a^2) / 2 = 4 with b_s = b_a = 2, M_phi = b_s = 2,
+    # |A| = 2 b_a = 4, gamma = 0.9
     by_hand = 4 * 4 / (0.1**2 * 1) * (4 / math.sqrt(2 * math.pi) + 0.9 / (2 * 0.1))
     assert penalty_constant(K1) == pytest.approx(by_hand, rel=1e-14)
     assert penalty_constant(K1) == pytest.approx(9753.3, abs=0.1)
