@@ -64,14 +64,18 @@ def test_static_sources_parse(tmp_path):
 
 def test_lqg_closed_form():
     env = LQG.thesis_1d()
-    cases = [(t, s) for t in np.linspace(-1.5, 0.05, 13) for s in (0.3, 1.0, 1.7)]
+    # Stable for |1 + theta| sqrt(0.9) < 1, theta in (-2.054, 0.054): the grid, and two gains outside it.
+    cases = [(t, s) for t in np.linspace(-1.5, 0.05, 13) for s in (0.3, 1.0, 1.7)] + [(0.1, 1.0), (-2.2, 0.5)]
     js = run_js([f"lib.lqgJ({t}, {s}, 0.9, 2)" for t, s in cases])
+    unstable = 0
     for (t, s), v in zip(cases, js):
         expected = env.performance(t, s)
         if math.isinf(expected):
             assert v is None  # JSON has no -Infinity: stringified as null
+            unstable += 1
         else:
             assert v == pytest.approx(expected, rel=1e-12)
+    assert len(js) == len(cases) == 41 and unstable == 2  # both branches checked
 
 
 @pytest.mark.parametrize("sigma", [0.5, 1.0, 2.0])
