@@ -30,13 +30,15 @@ MUTED = "#7f7f7f"
 ESTIMATOR_COLORS = {"reinforce": MUTED, "gpomdp": ACCENT}
 
 
-def use_style() -> None:
+def use_style(digest: bool = False) -> None:
     """Matplotlib defaults for the book, and high-DPI inline figures in a notebook.
 
     Under IPython, figures are shown as PNGs at twice the resolution (``"retina"``) with
     their display size recorded, so they stay sharp on high-density screens and when the
     browser zooms, and the book's pages keep their layout. No titles are drawn: the book
-    numbers and captions its figures.
+    numbers and captions its figures. With ``digest``, each figure's text form, which
+    nbval compares and the book does not show, is what it plots
+    (:func:`safepg.thesis.figure_digest.digest_figures`).
     """
     mpl.rcParams.update({
         "figure.facecolor": "white", "axes.facecolor": "white", "savefig.facecolor": "white",
@@ -51,6 +53,10 @@ def use_style() -> None:
         from matplotlib_inline.backend_inline import set_matplotlib_formats
 
         set_matplotlib_formats("retina")
+        if digest:
+            from safepg.thesis.figure_digest import digest_figures
+
+            digest_figures()
 
 
 def estimator_style(estimator: str) -> dict[str, Any]:
