@@ -89,6 +89,22 @@ def test_use_style_registers_the_digest_only_when_asked_and_only_in_a_kernel() -
     assert fd.digest_figures() is False
 
 
+def test_use_style_silences_the_legend_placement_timer_and_nothing_else() -> None:
+    """matplotlib warns when placing a legend at loc="best" took over a second of wall time: under load a
+    figure cell then wrote to stderr and failed nbval (book/lqg1d.ipynb's Figure 5.1 overlays, once)."""
+    import warnings
+
+    from safepg.thesis import plotting
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        plotting.use_style()
+        warnings.warn('Creating legend with loc="best" can be slow with large amounts of data.', UserWarning,
+                      stacklevel=1)
+        warnings.warn("another warning", UserWarning, stacklevel=1)
+    assert [str(w.message) for w in caught] == ["another warning"]
+
+
 # -------------------------------------------------------------------------- the proof under nbval
 _SETUP = """import matplotlib.pyplot as plt
 from safepg.thesis import plotting
