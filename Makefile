@@ -19,7 +19,7 @@ export VIRTUAL_ENV := $(CURDIR)/.venv
 export JUPYTER_PATH := $(CURDIR)/.venv/share/jupyter
 export JUPYTER_PREFER_ENV_PATH := 1
 
-.PHONY: setup setup-dev browser-deps lint test test-lib book book-assets bench lab wasm dist
+.PHONY: setup setup-dev browser-deps node-deps lint test test-lib book book-assets bench lab wasm dist
 
 # Creates .venv on first use (installing Debian's python3.X-venv as root if missing), reuses
 # it while requirements.txt and pyproject.toml are unchanged.
@@ -41,6 +41,10 @@ setup-dev: setup
 browser-deps:
 	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null)
 
+# Debian's Node.js for the tests that run the page's JavaScript against safepg (marked `node`).
+node-deps:
+	@command -v node >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq nodejs >/dev/null)
+
 # Lint (pyproject.toml's ruff rules) on the library, tests, benchmarks and the book's tools and extensions;
 # notebooks are checked by nbval.
 lint: setup-dev
@@ -48,11 +52,12 @@ lint: setup-dev
 	$(VPY) -m mypy
 
 # The book first, as `make book` builds it (its computations use every core), then the tests on every
-# core (pytest-xdist; a test file's tests run in one worker, in order: nbval's cells need that).
-test: setup setup-dev browser-deps lint book
+# core (pytest-xdist; a test file's tests run in one worker, in order: nbval's cells need that). Chromium
+# and Node.js come from Debian; a test that finds either missing fails under CI=true (tests/conftest.py).
+test: setup setup-dev browser-deps node-deps lint book
 	$(VPY) -m pytest -n $(TEST_JOBS) --dist loadfile
 
-test-lib: setup setup-dev
+test-lib: setup setup-dev node-deps
 	$(VPY) -m pytest tests -m "not browser"
 
 # MathJax from the npm registry into book/_vendor (pages render math offline), and axe-core into

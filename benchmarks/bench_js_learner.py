@@ -50,6 +50,9 @@ ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "js_learner_timings.json"
 #: The budgets (s, under Node on the 2-core build machine) of the vector tasks' figures.
 TARGETS_S = {"cartpole_1e5": 3.0, "lqg2d_fig57_tenth": 2.0}
+#: The budget (s) of the 1-D explorer's default run (10^6 trajectories) in the page's Web Worker. The browser
+#: test of the explorer (tests/test_browser_learner.py) reports that run's time and no longer limits it.
+EXPLORER_TARGET_S = 1.0
 
 NODE_BENCH = r"""
 const L = require(process.argv[2]);
@@ -280,7 +283,9 @@ def main() -> None:
         "safepg_numba": py,
         "chromium_explorer_run_1e6": browser and {**browser, "worker_best_s": min(browser["worker_s"]),
                                                   "page_best_s": min(browser["page_s"]),
-                                                  "browser_cpu_best_s": min(browser["browser_cpu_s"])},
+                                                  "browser_cpu_best_s": min(browser["browser_cpu_s"]),
+                                                  "target_s": EXPLORER_TARGET_S,
+                                                  "met": min(browser["worker_s"]) <= EXPLORER_TARGET_S},
         "ratio_js_over_numba": {k: {"wall": js[k]["wall_ms"] / py[k]["wall_ms"],
                                     "cpu": js[k]["cpu_ms"] / py[k]["cpu_ms"]} for k in py},
         "per_step_ns_cpu": {f"{impl}_{k}": 1e6 * v[k]["cpu_ms"] / steps[k]

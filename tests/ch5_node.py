@@ -5,14 +5,13 @@ Python twins in tests/test_lqg2d_learner.py and tests/test_cartpole_learner.py."
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 from typing import Any
 
+from conftest import require_node
 from safepg.thesis.explorers.component import static_text
 from safepg.thesis.explorers.js_tasks import learner_sources
 
-NODE = shutil.which("node")
 #: Control moves that each change what the Chapter 5 explorers draw, in the page
 #: (tests/test_browser_live_ch5.py) and in the kernel view (tests/test_kernel_view_ch5.py).
 CH5_MOVES: dict[str, list[tuple[str, Any]]] = {
@@ -44,8 +43,9 @@ def run_page(script: str, obj: str, cases: list[dict[str, Any]]) -> list[dict[st
     ``configs``, the answer's ``completed`` holds each run's configuration as the learner completes it), or
     ``{"links", "linked": [name, value]}`` for the page's answer to a control's move (``safepgCh5Linked``)."""
     src = "\n".join([learner_sources(), static_text("live_jobs.js"), static_text("ch5_page.js"), static_text(script)])
-    proc = subprocess.run([NODE, "-e", _SCRIPT], input=json.dumps({"src": src, "object": obj, "cases": cases}),
-                          capture_output=True, text=True, timeout=120, check=False)
+    proc = subprocess.run([require_node(), "-e", _SCRIPT],
+                          input=json.dumps({"src": src, "object": obj, "cases": cases}), capture_output=True,
+                          text=True, timeout=120, check=False)
     if proc.returncode:
         raise RuntimeError(proc.stderr)
     return json.loads(proc.stdout)

@@ -1,5 +1,5 @@
 """Shared fixtures: the built book and Debian's headless Chromium for the browser tests, and
-``views`` for the tests of the explorers' kernel views.
+``views`` for the tests of the explorers' kernel views; the ``node`` marker and the skip report.
 
 ``book`` builds the book once per test run, as ``make book`` does (notebook execution goes
 through the Jupyter Book cache, so a rebuild with unchanged notebooks takes seconds); under
@@ -10,6 +10,13 @@ browser. Without Chromium (or Playwright) the browser tests are skipped, except 
 installs Chromium). A test asks for ``browser`` before ``book``, so a skipped test does
 not build the book first. Only one Playwright instance may run per process: every
 browser test shares this one.
+
+Every test that needs something of the machine goes through :func:`skip_or_fail`: the tests
+marked ``node`` (Node.js runs the page's JavaScript; ``make node-deps`` installs Debian's
+``nodejs``) as the browser tests do, and the others that need a program or a package that
+``make test`` installs. Under ``CI=true`` such a test fails with the package to install instead
+of skipping. Every run ends with the list of its skips (``skip_report.SkipReport``); under
+``CI=true`` a skip that the README's list of skips does not name fails the run.
 """
 
 from __future__ import annotations
@@ -29,6 +36,8 @@ ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
 SHOTS = ROOT / "_build" / "screenshots"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+#: Node.js, which runs the page's JavaScript against safepg (the tests marked ``node``); None if missing.
+NODE = shutil.which("node")
 #: The jupyter-book of the interpreter running the tests (.venv's under `make test`), not the
 #: first one on the PATH: that one would build the book with another environment's safepg.
 JUPYTER_BOOK = str(Path(sys.executable).with_name("jupyter-book"))
@@ -37,7 +46,8 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-backg
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Under pytest-xdist, numba's parallel kernels start on one thread in each worker.
+    """Under pytest-xdist, numba's parallel kernels start on one thread in each worker; the process that
+    reports the run lists its skips (``skip_report.SkipReport``).
 
     The workers already share the cores; with numba's threads on every core too, two workers'
     parallel regions wait on each other's descheduled threads (a module's setup took 56 s instead
@@ -48,6 +58,10 @@ def pytest_configure(config: pytest.Config) -> None:
         import numba
 
         numba.set_num_threads(1)
+    else:  # the process that reports the run (pytest-xdist's controller, or the only one)
+        from skip_report import SkipReport
+
+        config.pluginmanager.register(SkipReport(ci=in_ci()), "safepg-skip-report")
 
 
 def in_ci() -> bool:
@@ -55,11 +69,39 @@ def in_ci() -> bool:
     return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
 
 
-def skip_or_fail(reason: str) -> None:
-    """Skip the test, or fail it under CI."""
+def skip_or_fail(reason: str, allow_module_level: bool = False) -> None:
+    """Skip the test, or fail it under CI: what ``make test`` installs is there in CI, so a test that
+    finds it missing must not pass by skipping. ``reason`` names what to install; with
+    ``allow_module_level``, called at a module's import, it skips (or fails) the whole module."""
     if in_ci():
-        pytest.fail(f"{reason} (CI=true: browser tests must run)")
-    pytest.skip(reason)
+        pytest.fail(f"{reason} (CI=true: this test must run, not skip)")
+    pytest.skip(reason, allow_module_level=allow_module_level)
+
+
+def require_node() -> str:
+    """The path of Node.js; :func:`skip_or_fail` without it."""
+    if NODE is None:
+        skip_or_fail("node is missing: run `make node-deps` (apt-get install nodejs)")
+    assert NODE is not None
+    return NODE
+
+
+def import_or_fail(module: str, requirements: str = "requirements.txt") -> Any:
+    """``module`` imported; else :func:`skip_or_fail` (the whole module when called at its import), naming
+    the file that pins it (``make setup`` installs requirements.txt, ``make setup-dev`` requirements-dev.txt)."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        skip_or_fail(f"{module} is not installed: run `make setup setup-dev` (it is pinned in {requirements})",
+                     allow_module_level=True)
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """A test marked ``node`` needs Node.js (:func:`require_node`)."""
+    if item.get_closest_marker("node") is not None:
+        require_node()
 
 
 def build_book() -> Path:

@@ -129,13 +129,17 @@ def test_table_5_1_J_column_reads_sigma_as_the_variance() -> None:
 def test_table_5_2_with_the_shortest_run_and_90_percent_intervals() -> None:
     printed = get_experiment("table-5.2").thesis
     recomputed = A.table_5_2()
+    five = one = 0
     for (est, bound, er, delta), row in recomputed.items():
         p = printed[t52_name(est, bound, er, delta)]
         if row["runs"] == 5:
             assert round(row["mean"], 4) == p["upsilon_bar"]
             assert [round(v, 4) for v in row["ci90"]] == p["ci95"]  # printed as "95%"
+            five += 1
         else:  # Bernstein e.r.: one of the five runs is committed
             assert (bound, er, round(row["mean"], 4), p["upsilon_bar"]) == ("bernstein", True, -9.6625, -9.6623)
+            one += 1
+    assert (five, one) == (11, 1)  # every row of Table 5.2 checked
     assert recomputed[("reinforce", "chebyshev", False, 0.95)]["T"] == 1275
     # A 95% interval would not be the print.
     row = recomputed[("reinforce", "chebyshev", False, 0.95)]

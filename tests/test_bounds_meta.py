@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy import stats
 
 from safepg.bounds import (
     ErrorBound,
@@ -38,7 +39,8 @@ pos = st.floats(min_value=1e-2, max_value=1e2, allow_nan=False)
 
 
 def test_penalty_constant_by_hand():
-    # R = 4, M_phi = 2, |A| = 4, gamma = 0.9, sigma = 1 (SETTINGS.md)
+    # LQG.thesis_1d() with sigma = 1: R = (b_s^2 + b_a^2) / 2 = 4 with b_s = b_a = 2, M_phi = b_s = 2,
+    # |A| = 2 b_a = 4, gamma = 0.9
     by_hand = 4 * 4 / (0.1**2 * 1) * (4 / math.sqrt(2 * math.pi) + 0.9 / (2 * 0.1))
     assert penalty_constant(K1) == pytest.approx(by_hand, rel=1e-14)
     assert penalty_constant(K1) == pytest.approx(9753.3, abs=0.1)
@@ -74,18 +76,99 @@ def test_error_bound_selects_the_right_ingredients():
     assert error_bound("chebyshev", x, 0.2, K1, "reinforce").d > error_bound("chebyshev", x, 0.2, K1).d
 
 
-@pytest.mark.parametrize("which", ["hoeffding", "bernstein"])
-def test_bounds_hold_with_probability_at_least_one_minus_delta(which):
-    # Bounded variables in [0, 1]: the bound fails in at most a delta share of batches.
-    rng = np.random.default_rng(1)
-    delta, n, reps = 0.2, 50, 20_000
-    x = rng.beta(0.3, 0.3, size=(reps, n))
-    mean = 0.5
+# ------------------------------------------------------- coverage where each bound is nearly tight
+# Each bound is tested where it is close to attained, so that a bound made smaller by a factor 0.7 fails
+# (the negative control: at 0.7 eps the miss rate exceeds delta), and with enough batches that both
+# assertions hold by many Monte Carlo standard errors (SE), computed below from the exact miss rates.
+#: Batches per Monte Carlo estimate of a miss rate: at a rate p its SE is sqrt(p (1 - p) / BATCHES),
+#: 7.1e-5 at p = 0.001 and 6.7e-4 at p = 0.1.
+BATCHES = 200_000
+#: Hoeffding and Bernstein: batches of N = 10^5 samples of the two-point distribution {0, 1} with
+#: p = 1/2 (the largest variance of a range of 1, so the tail Hoeffding bounds is the heaviest), at
+#: delta = 0.001, where the smallest eps that covers is 0.84 of Hoeffding's and 0.79 of Bernstein's.
+TWO_POINT_N, TWO_POINT_DELTA = 100_000, 0.001
+#: The margin, in SE, that makes an assertion on a miss rate decisive.
+DECISIVE_SE = 8.0
+
+
+def _two_point_miss_rates(which: str, scale: float) -> tuple[float, float]:
+    """Share of batches whose mean misses 1/2 by at least scale * eps: Monte Carlo over BATCHES batches, and
+    exact (the binomial sum over the count of ones, which is all that a batch's mean, sample variance and
+    range depend on)."""
+    n, delta = TWO_POINT_N, TWO_POINT_DELTA
+    k = np.arange(n + 1)
+    # eps of a batch with k ones: its sample variance (ddof = 1) is k (n - k) / (n (n - 1)), its range 1.
+    variance = k * (n - k) / (n * (n - 1.0))
     if which == "hoeffding":
-        eps = np.full(reps, hoeffding(delta, 1.0).eps(n))
+        eps = np.full(n + 1, hoeffding(delta, 1.0).eps(n))
     else:
-        eps = np.array([bernstein(delta, np.var(r, ddof=1), 1.0).eps(n) for r in x])
-    assert np.mean(np.abs(x.mean(axis=1) - mean) >= eps) <= delta
+        eps = np.array([bernstein(delta, v, 1.0).eps(n) for v in variance])
+    miss = np.abs(k / n - 0.5) >= scale * eps
+    exact = float(stats.binom.pmf(k, n, 0.5)[miss].sum())
+    ones = np.random.default_rng(55).binomial(n, 0.5, size=BATCHES)
+    return float(miss[ones].mean()), exact
+
+
+def _se(p: float) -> float:
+    return math.sqrt(p * (1 - p) / BATCHES)
+
+
+@pytest.mark.parametrize("which", ["hoeffding", "bernstein"])
+def test_two_point_coverage_where_the_bound_is_nearly_tight(which):
+    """At eps the miss rate is at most delta; at 0.7 eps it exceeds delta (the negative control).
+
+    Exact miss rates (binomial sums): Hoeffding 9.7e-5 at eps and 6.4e-3 at 0.7 eps; Bernstein 3.3e-5 and
+    3.7e-3; delta = 1e-3. With SE 7.1e-5 at delta, 1.8e-4 and 1.4e-4 at 0.7 eps: the first assertion holds by
+    12.7 and 13.6 SE, the second by 30 and 19 SE.
+    """
+    delta = TWO_POINT_DELTA
+    at_eps, exact_eps = _two_point_miss_rates(which, 1.0)
+    at_07, exact_07 = _two_point_miss_rates(which, 0.7)
+    # The setting is decisive: both exact rates lie many SE from delta (sizes chosen so).
+    assert (delta - exact_eps) / _se(delta) > DECISIVE_SE and (exact_07 - delta) / _se(exact_07) > DECISIVE_SE
+    # The Monte Carlo estimates agree with the exact rates (5 SE), and each lies on its side of delta.
+    assert abs(at_eps - exact_eps) <= 5 * _se(max(exact_eps, 1 / BATCHES)) and at_eps <= delta, (at_eps, exact_eps)
+    assert abs(at_07 - exact_07) <= 5 * _se(exact_07) and at_07 > delta, (at_07, exact_07)
+
+
+#: Chebyshev: the mean of N = 10 draws of X in {0, +-7.5, +-10}, P(|X| = 7.5) = 0.006, P(|X| = 10) = 0.0065
+#: (rare values: a batch's mean is one of them / 10 with probability about 0.06 and 0.065), at delta = 0.1.
+#: Var X = 0.9875, eps = sqrt(Var X / (delta N)) = 0.9937: a batch holding one 10 misses by 1 >= eps, one
+#: holding one 7.5 misses by 0.75 >= 0.7 eps = 0.6956. Chebyshev's inequality is nearly an equality here:
+#: the smallest eps that covers is 0.755 of its eps.
+CHEBYSHEV_X = np.array([0.0, 7.5, -7.5, 10.0, -10.0])
+CHEBYSHEV_P = np.array([1 - 0.0125, 0.003, 0.003, 0.00325, 0.00325])
+CHEBYSHEV_N, CHEBYSHEV_DELTA = 10, 0.1
+
+
+def _chebyshev_exact_miss(eps: float) -> float:
+    """P(|mean of N draws of X| >= eps), from the distribution of their sum (X in units of 2.5: 0, +-3, +-4)."""
+    pmf = np.zeros(9)
+    pmf[[4, 7, 1, 8, 0]] = CHEBYSHEV_P  # units -4 .. 4 at indices 0 .. 8
+    total = np.array([1.0])
+    for _ in range(CHEBYSHEV_N):
+        total = np.convolve(total, pmf)
+    mean = 2.5 * (np.arange(total.size) - 4 * CHEBYSHEV_N) / CHEBYSHEV_N
+    return float(total[np.abs(mean) >= eps].sum())
+
+
+def test_chebyshev_coverage_where_the_bound_is_nearly_tight():
+    """At eps the miss rate is at most delta; at 0.7 eps it exceeds delta (the negative control).
+
+    Exact miss rates: 0.0614 at eps, 0.1150 at 0.7 eps (delta = 0.1). With SE 6.7e-4 at delta and 7.1e-4 at
+    0.7 eps, the first assertion holds by 57 SE, the second by 21 SE.
+    """
+    variance = float(CHEBYSHEV_P @ CHEBYSHEV_X**2)
+    assert variance == pytest.approx(0.9875, rel=1e-12) and abs(CHEBYSHEV_P @ CHEBYSHEV_X) < 1e-15  # mean 0
+    eps = chebyshev(CHEBYSHEV_DELTA, variance).eps(CHEBYSHEV_N)
+    draws = np.random.default_rng(56).choice(CHEBYSHEV_X, p=CHEBYSHEV_P, size=(BATCHES, CHEBYSHEV_N))
+    dev = np.abs(draws.mean(axis=1))
+    for scale, above in ((1.0, False), (0.7, True)):
+        exact = _chebyshev_exact_miss(scale * eps)
+        observed = float(np.mean(dev >= scale * eps))
+        assert abs(exact - CHEBYSHEV_DELTA) / _se(exact if above else CHEBYSHEV_DELTA) > DECISIVE_SE, (scale, exact)
+        assert abs(observed - exact) <= 5 * _se(exact), (scale, observed, exact)
+        assert (observed > CHEBYSHEV_DELTA) if above else (observed <= CHEBYSHEV_DELTA), (scale, observed)
 
 
 @settings(max_examples=60, deadline=None)

@@ -4,8 +4,8 @@ Complements ``test_browser.py`` (per-explorer checks against safepg): here every
 listed in ``_toc.yml`` is opened from disk (file://) in headless Chromium and must load
 with no JavaScript error, no request leaving the disk, every formula typeset by the
 vendored MathJax without a TeX error, and every image decoded. The 1-D LQG explorer is
-then moved with the keyboard and its plotted numbers are compared with the closed form
-of SETTINGS.md, written out here independently of safepg, and with safepg's own.
+then moved with the keyboard and its plotted numbers are compared with the 1-D closed form
+(derived by hand, see tests/test_lqg.py), written out here independently of safepg, and with safepg's own.
 Screenshots (light and dark theme) go to ``_build/screenshots/``.
 
 ``test_every_page_reads_well`` opens every page at a desktop (1280 px) and a phone
@@ -45,7 +45,7 @@ LQG_TITLE = "1-D LQG: expected performance and estimator variance"
 
 
 def lqg_performance(theta: float | np.ndarray, sigma: float, gamma: float = 0.9, b: float = 2.0) -> np.ndarray:
-    """J(theta) of the 1-D LQG (SETTINGS.md), independent of safepg:
+    """J(theta) of the 1-D LQG (the closed form derived by hand in tests/test_lqg.py), independent of safepg:
     J = -(b^2/3) P - sigma^2 (0.5 + gamma P) / (1 - gamma), P = 0.5 (1 + theta^2) / (1 - gamma (1 + theta)^2)."""
     theta = np.asarray(theta, dtype=float)
     P = 0.5 * (1 + theta**2) / (1 - gamma * (1 + theta) ** 2)

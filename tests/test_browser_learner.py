@@ -3,14 +3,16 @@
 The explorer is rendered into its own page (no book build needed), opened from disk with
 every non-file request blocked, and driven like a reader would: every control is moved and
 must change the curves; a long run must draw progressively and be cancelled by the next
-move; no console error may appear. The 10^6-trajectory adaptive run (the page's default)
-is timed; the time is printed and written to ``_build/screenshots/live_learner_timing.json``
-(``benchmarks/bench_js_learner.py`` records it too).
+move; no console error may appear. The 10^6-trajectory adaptive run (the page's default) is held
+against the statistics that tests/test_learner_js.py's agreement runs stored for the same settings
+(``benchmarks/js_learner_agreement.json``). Its time is printed and written to
+``_build/screenshots/live_learner_timing.json``; the limit on it is ``benchmarks/bench_js_learner.py``'s.
 """
 
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -22,8 +24,10 @@ from browser_pages import OfflinePage
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "_build" / "screenshots"
 pytestmark = pytest.mark.browser
-#: Generous: the build machine is shared; the target is < 1 s, reported by the test.
-MAX_RUN_SECONDS = 20.0
+#: The agreement runs' statistics (``python tests/test_learner_js.py`` writes them).
+STATISTICS = ROOT / "benchmarks" / "js_learner_agreement.json"
+#: Their row of the page's default settings: Bernstein (e.r.), G(PO)MDP, sigma = 1, delta = 0.95, 10^6 trajectories.
+PAGE_DEFAULT = ("bernstein (e.r.) | gpomdp | 1.0", "mean J at 10^6")
 
 
 def stored_runs(budget: int = 3_000_000, seeds: int = 1) -> tuple[dict[str, list[Any]], list[Any]]:
@@ -48,33 +52,19 @@ def explorer_page(tmp_path_factory) -> tuple[Path, Any]:
     return path, explorer
 
 
-def python_run_seconds(params: dict) -> float:
-    """Best of three: the page's default run (Algorithm 4.1, its settings) with safepg, one thread
-    like the page's Web Worker, after a warm-up run compiled the kernel."""
-    import time
+def stored_statistics() -> dict[str, Any]:
+    """The agreement runs' row of the page's default settings: JS and safepg means, standard deviations, seeds,
+    and every seed's value."""
+    rows = json.loads(STATISTICS.read_text())["1-D LQG"]
+    return next(r for r in rows if (r["setting"], r["metric"]) == PAGE_DEFAULT)
 
-    import numba
 
-    from safepg.envs.lqg import LQG
-    from safepg.learning import adaptive_pg
-    from safepg.options import ErrorModel, Gradient
+def one_run_interval(mean: float, sd: float, seeds: int, level: float = 0.999) -> tuple[float, float]:
+    """The ``level`` prediction interval for one new run of a process whose ``seeds`` runs had ``mean``, ``sd``."""
+    from scipy import stats
 
-    bound, er = (params["bound"].removesuffix("-er"), params["bound"].endswith("-er"))
-    kw = dict(gradient=Gradient(params["estimator"], params["baseline"] == "on", params["score"]),
-              error=ErrorModel(bound, float(params["delta"]), "empirical" if er else "lemma"),
-              budget=int(params["budget"]), rng=int(params["seed"]))
-    before = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        adaptive_pg(LQG.thesis_1d(), 0.0, float(params["sigma"]), **{**kw, "budget": 10_000})
-        best = float("inf")
-        for _ in range(3):
-            t0 = time.perf_counter()
-            adaptive_pg(LQG.thesis_1d(), 0.0, float(params["sigma"]), **kw)
-            best = min(best, time.perf_counter() - t0)
-    finally:
-        numba.set_num_threads(before)
-    return best
+    half = float(stats.t.ppf(0.5 + level / 2, seeds - 1)) * sd * math.sqrt(1 + 1 / seeds)
+    return mean - half, mean + half
 
 
 def values(pg: OfflinePage) -> dict:
@@ -119,20 +109,24 @@ def test_live_learner_runs_offline_and_every_control_redraws(browser, explorer_p
     py = explorer.compute_py(first["params"])
     assert res["thesis"]["found"] and res["thesis"] == py["values"]["thesis"]
     assert curves(first)["N"]["series"][0]["y"] == py["plots"]["N"]["series"][0]["y"]
-    # Same structure as the Python twin, and the same kind of numbers (another generator).
+    # Same structure as the Python twin, and the same kind of numbers (another generator): J at 10^6
+    # trajectories inside the 99.9% prediction interval for one run of safepg's stored seeds (it detects a
+    # shift of 4.6 of their standard deviations, 0.032 on -14.74, with 80% power) ...
     assert set(a) == set(py["values"]["adaptive"])
-    assert abs(a["J_at"]["1000000"] - py["values"]["adaptive"]["J_at"]["1000000"]) < 3.0
+    stored = stored_statistics()
+    lo, hi = one_run_interval(stored["py"], stored["py_sd"], int(stored["seeds"]))
+    J = a["J_at"]["1000000"]
+    assert lo <= J <= hi, (J, lo, hi)
+    # ... and, the same learner with the same seed, the JavaScript agreement run of seed 0 under Node.
+    assert int(first["params"]["seed"]) == 0 and J == pytest.approx(stored["js_values"][0], rel=1e-12)
     seconds = res["run_ms"]["adaptive"] / 1000
-    py_seconds = python_run_seconds(first["params"])
     SHOTS.mkdir(parents=True, exist_ok=True)
     (SHOTS / "live_learner_timing.json").write_text(json.dumps(
         {"adaptive_1e6_run_s": seconds, "vanilla_1e6_run_s": res["run_ms"]["vanilla"] / 1000,
-         "page_elapsed_s": res["elapsed_ms"] / 1000, "python_kernel_1e6_run_s": py_seconds,
-         "ratio_page_to_python": seconds / py_seconds}, indent=1))
+         "page_elapsed_s": res["elapsed_ms"] / 1000}, indent=1))
     print(f"\n10^6-trajectory adaptive run in headless Chromium: {seconds:.3f} s "
-          f"(both runs, page wall time {res['elapsed_ms'] / 1000:.3f} s); the same run with safepg's numba "
-          f"kernel on one thread: {py_seconds:.3f} s, ratio {seconds / py_seconds:.2f}")
-    assert seconds < MAX_RUN_SECONDS
+          f"(both runs, page wall time {res['elapsed_ms'] / 1000:.3f} s); J at 10^6 {J:.4f}, one run of safepg's "
+          f"{int(stored['seeds'])} stored seeds lies in [{lo:.4f}, {hi:.4f}] with probability 0.999")
     pg.page.locator(".safepg-explorer").first.screenshot(path=str(SHOTS / "live-learner.png"))
 
     # Every control: a move starts a new run whose curves differ from the previous ones.

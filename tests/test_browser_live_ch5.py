@@ -168,8 +168,7 @@ def test_cartpole_explorer(browser, pages):
 def test_default_cartpole_run_is_frozen(browser, pages):
     path, _ = pages["cartpole"]
     pg = OfflinePage(browser, path, width=1000, height=2400)
-    v = wait_done(pg)
-    assert v["result"]["values"]["elapsed_ms"] < 60_000
+    v = wait_done(pg)  # how long it takes is benchmarks/bench_js_learner.py's (the cart-pole's 3 s target)
     a = v["result"]["values"]["adaptive"]
     assert a["frozen"] and "theta did not move: " in v["result"]["text"]
     assert v["result"]["values"]["vanilla"]["theta_moved"][1] > 1e-3  # the fixed step moves it

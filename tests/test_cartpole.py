@@ -11,12 +11,13 @@ import warnings
 import numpy as np
 import pytest
 
+from conftest import import_or_fail
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import ENV_ID, CartPole, step_dynamics
 from safepg.policies import LinearGaussianPolicy
 from safepg.streams import batch_key, trajectory_draws
 
-gym = pytest.importorskip("gymnasium")
+gym = import_or_fail("gymnasium")
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv  # noqa: E402
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 

@@ -10,7 +10,7 @@ import json
 
 import numpy as np
 import pytest
-from ch5_node import NODE, run_page
+from ch5_node import run_page
 
 from safepg.envs.cartpole import CartPole
 from safepg.learning import learn
@@ -30,7 +30,7 @@ from safepg.thesis.explorers.ch5_live import record_c, record_trace
 from safepg.thesis.explorers.js_tasks import cartpole_task_data
 from safepg.thesis.explorers.option_names import learner_options
 
-needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
+needs_node = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 BOXES = [name for name, *_ in SETTINGS]
 #: Each box: the CartPole fields and the options of Algorithm 4.1 it sets (under the page learner's
 #: names, option_names.learner_options), and nothing else.

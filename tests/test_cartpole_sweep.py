@@ -184,6 +184,7 @@ def test_sweep_experiments_are_well_formed() -> None:
     exp = get_experiment("cartpole-sweep")
     assert exp.performance == "J_hat" and exp.seeds == 2
     names = {c.name for c in exp.configs}
+    doubled = 0
     for st in CARTPOLE_SWEEP.values():
         base = get_experiment(st.baseline_experiment)
         assert len(base.configs) == 1 and base.configs[0].method.target.value == 195.0
@@ -192,6 +193,7 @@ def test_sweep_experiments_are_well_formed() -> None:
         if not st.doubled:
             assert f"{st.key}:adaptive" not in names
             continue
+        doubled += 1
         ad = exp.config(f"{st.key}:adaptive")
         assert (ad.algorithm, ad.method.error, ad.budget) == ("adaptive", ErrorModel("bernstein", 0.95, "empirical"),
                                                               SWEEP_BUDGET)
@@ -205,6 +207,7 @@ def test_sweep_experiments_are_well_formed() -> None:
             assert (v.method.batch_size, v.method.step, v.warm_start) == (4000, FixedStep(0.01), st.baseline_experiment)
             assert make_env(v.task) == CartPole.thesis_doubled(**st.task)
     assert "cartpole-sweep" in EXPERIMENTS and "thesis:N=4000" in names
+    assert doubled == sum(c.name.endswith(":adaptive") for c in exp.configs) >= 5  # each adaptive config checked
 
 
 # ------------------------------------------------------------------ summaries

@@ -98,11 +98,13 @@ def test_no_bare_thesis_number_in_the_sources_of_the_pages():
     """The pages' prose and the text the library generates name works, never "[24]"."""
     cites = re.compile(r"(?:of|from|in|by|et al\.|step|/)\s\[\d{1,2}\]|\[\d{1,2}\]'s")
     offenders = []
-    for path in [*(ROOT / "book").glob("*.md"), *(ROOT / "safepg").rglob("*.py")]:
+    paths = [*(ROOT / "book").glob("*.md"), *(ROOT / "safepg").rglob("*.py")]
+    for path in paths:
         for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
             if cites.search(line):
                 offenders.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert not offenders, "\n".join(offenders)
+    assert len(paths) >= 80  # the book's Markdown pages and the library's modules were read
 
 
 # --- the built pages ---------------------------------------------------------------------------
@@ -169,10 +171,12 @@ def _pages(book: Path) -> dict[str, _Page]:
 
 def test_no_page_shows_a_bare_thesis_number(book):
     found = []
-    for name, page in _pages(book).items():
+    pages = _pages(book)
+    for name, page in pages.items():
         text = "".join(page.text)
         found += [f"{name}: ...{text[max(0, m.start() - 60):m.end() + 20]!r}" for m in BARE.finditer(text)]
     assert not found, "bare citation numbers on the pages:\n" + "\n".join(found)
+    assert len(pages) >= 10  # every chapter, the scorecard, the API and the references
 
 
 def test_every_citation_links_to_its_reference(book):

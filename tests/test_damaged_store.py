@@ -221,8 +221,9 @@ def test_warm_start_sets_a_damaged_starting_run_aside(root, monkeypatch):
     first = es.run_experiment(warm, root=root)[warm.configs[0].name][0]
     path = runner.run_path(es.experiment_folder(cheap, root), cheap.configs[0], 0)
     _damage(path, "truncated")
-    for stored in es.experiment_folder(warm, root).rglob("seed-0.npz"):
-        stored.unlink()  # so the warm-started run is computed again, from the recomputed start
+    stored = list(es.experiment_folder(warm, root).rglob("seed-0.npz"))
+    assert len(stored) == 1
+    stored[0].unlink()  # so the warm-started run is computed again, from the recomputed start
     with pytest.warns(store.DamagedRunWarning, match="set aside"):
         again = es.run_experiment(warm, root=root)[warm.configs[0].name][0]
     assert list(path.parent.glob(f"seed-0.npz{store.DAMAGED_SUFFIX}*"))

@@ -94,7 +94,8 @@ def test_interrupted_or_partial_files_are_recomputed(root):
 
 def test_report_structure(root):
     exp = small(configs=2, seeds=3, budget=120_000)
-    rep = rp.report(exp, es.run_experiment(exp, jobs=1, progress=False))
+    records = es.run_experiment(exp, jobs=1, progress=False)
+    rep = rp.report(exp, records)
     assert rep["experiment"] == "table-5.2" and len(rep["configs"]) == 2
     row = rep["configs"][0]
     for key in ("name", "method", "sigma", "budget", "seeds", "upsilon_bar", "improvement_ratio", "J_at", "J_final",
@@ -102,8 +103,17 @@ def test_report_structure(root):
         assert key in row
     assert row["seeds"] == 3 and row["method"]["gradient"]["estimator"] == "reinforce"
     assert row["method"]["error"]["bound"] == "chebyshev"
-    lo, hi = row["upsilon_bar"]["ci95"]
-    assert lo <= row["upsilon_bar"]["mean"] <= hi
+    # The row's Upsilon-bar: the mean of the three seeds' runs, its 95% interval and the 95% prediction interval
+    # for one more run, recomputed here with scipy's t quantile.
+    from scipy import stats as scipy_stats
+
+    ups = np.array([r.upsilon_bar() for r in records[exp.configs[0].name]])
+    assert ups.size == 3 and np.ptp(ups) > 0
+    t, m, sd = scipy_stats.t.ppf(0.975, 2), ups.mean(), ups.std(ddof=1)
+    got = row["upsilon_bar"]
+    assert got["mean"] == pytest.approx(m, rel=1e-12)
+    assert got["ci95"] == pytest.approx([m - t * sd / np.sqrt(3), m + t * sd / np.sqrt(3)], rel=1e-9)
+    assert got["pi95"] == pytest.approx([m - t * sd * np.sqrt(1 + 1 / 3), m + t * sd * np.sqrt(1 + 1 / 3)], rel=1e-9)
     assert list(row["J_at"]) == ["100000"]
     assert row["thesis"]["upsilon_bar"] == -11.3266
 

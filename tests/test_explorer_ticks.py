@@ -7,22 +7,21 @@ The browser test (test_browser_book.py) checks the drawn labels stay inside each
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 
 import pytest
 
+from conftest import require_node
 from safepg.thesis.explorers.component import static_text
 
-NODE = shutil.which("node")
-pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 
 
 def axis(lo: float, hi: float, log: bool) -> tuple[list[float], list[str]]:
     """Tick values and labels of an axis from lo to hi (for a log axis, lo and hi are log10)."""
     script = (static_text("runtime.js") + f"\nconst t = safepgTicks({lo}, {hi}, {str(log).lower()});"
               f"\nconsole.log(JSON.stringify([t, safepgTickLabels(t, {str(log).lower()})]));")
-    out = subprocess.run([NODE, "-e", script], capture_output=True, text=True, check=True).stdout
+    out = subprocess.run([require_node(), "-e", script], capture_output=True, text=True, check=True).stdout
     ticks, labels = json.loads(out)
     return ticks, labels
 

@@ -14,7 +14,9 @@ from typing import Any
 import pytest
 from ch5_node import CH5_MOVES
 
-pytest.importorskip("ipywidgets")
+from conftest import import_or_fail
+
+import_or_fail("ipywidgets")
 
 #: Seconds a computation may take on the shared 2-core machine (numba compiles on first use).
 WAIT = 600

@@ -11,6 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from conftest import import_or_fail
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord
 from safepg.thesis.experiments import get_experiment, t52_name
@@ -112,7 +113,7 @@ def test_python_twin(stored):
 
 
 def test_interactive_builds_widgets():
-    pytest.importorskip("ipywidgets")
+    import_or_fail("ipywidgets")
     ex = live_batch_size_explorer()
     calls = []
     # The view computes the defaults at once, in its worker thread: a stub stands in for the learning run.

@@ -10,7 +10,9 @@ from safepg.policies import LinearGaussianPolicy
 
 
 def j_1d_settings(theta: float, sigma: float, gamma: float = 0.9) -> float:
-    """SETTINGS.md's hand-derived 1-D closed form."""
+    """The 1-D closed form, derived by hand: under a = theta s + sigma z the value of a state is -P s^2 - w,
+    where P = (1 + theta^2) / 2 + gamma (1 + theta)^2 P and w = sigma^2 (1/2 + gamma P) / (1 - gamma) (the
+    noise's cost now and through the next state); J = -E[s_0^2] P - w with E[s_0^2] = 2^2 / 3."""
     P = 0.5 * (1 + theta**2) / (1 - gamma * (1 + theta) ** 2)
     return -(2**2 / 3) * P - sigma**2 * (0.5 + gamma * P) / (1 - gamma)
 
@@ -23,10 +25,15 @@ SIG2 = np.array([[0.5, 0.1], [0.1, 0.3]])
 
 def test_thesis_1d_numbers():
     env = LQG.thesis_1d()
+    # theta = 0: P = 0.5 / 0.1 = 5, J = -(4/3) 5 - (0.5 + 0.9 * 5) / 0.1 = -56.667 (j_1d_settings, by hand).
     assert env.performance(0.0, 1.0) == pytest.approx(-56.667, abs=5e-4)
+    # theta* and J(theta*): the maximum of the hand-derived closed form, -0.5884 and -13.207.
+    best = minimize_scalar(lambda t: -j_1d_settings(t, 1.0), bounds=(-1.0, 0.0), method="bounded",
+                           options={"xatol": 1e-10})
+    assert (round(best.x, 4), round(-best.fun, 3)) == (-0.5884, -13.207)
     theta_star = env.optimal_gain().item()
-    assert theta_star == pytest.approx(-0.5884, abs=5e-5)
-    assert env.performance(theta_star, 1.0) == pytest.approx(-13.207, abs=5e-4)
+    assert theta_star == pytest.approx(best.x, abs=5e-8)
+    assert env.performance(theta_star, 1.0) == pytest.approx(-best.fun, rel=1e-12)
 
 
 @pytest.mark.parametrize("theta", [-0.9, -0.588, -0.3, 0.0, 0.05])

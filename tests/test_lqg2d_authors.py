@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import os
 import re
 import subprocess
 from pathlib import Path
@@ -23,8 +26,9 @@ from safepg.thesis.authors import AuthorsRun
 
 #: Printed in the thesis (line 1087): J(theta*) ~ -422.616, theta* ~ diag(-0.588).
 PRINTED_J_STAR = -422.616
-#: The local mirror of the authors' repository, when present (the audit's sources are checked against it).
-MIRROR = Path("/work/.mirror/T3p+adaptive-batch-size/repo/.git")
+#: Names a copy of the authors' repository (a clone or a bare git directory), where one exists: the files the
+#: audit cites are then checked against it as well as against their record (tools/record_audit_sources.py).
+MIRROR_VARIABLE = "SAFEPG_AUTHORS_MIRROR"
 
 
 # ------------------------------------------------------------------ their J, by hand
@@ -115,23 +119,82 @@ def test_section_5_2_audit_names_the_findings() -> None:
     assert "table-s5-40" in table._repr_markdown_()
 
 
-@pytest.mark.skipif(not MIRROR.is_dir(), reason="the authors' repository is not mirrored here")
-@pytest.mark.parametrize("section", audit.SECTIONS)
-def test_audit_sources_exist_in_the_authors_repository(section: str) -> None:
-    for row in audit.audit(section):
-        for source in row.sources:
-            m = audit.SOURCE.match(source)
-            if m["path"].endswith("polgrad_theta0_N100_alpha6_sample1.out"):
-                # Committed, but the blob is absent from the repository (the row's point).
-                tree = subprocess.run(["git", "-C", str(MIRROR), "ls-tree", m["commit"], m["path"]],
-                                      capture_output=True, text=True, check=True).stdout
-                assert "2b2178b" in tree, source
-                continue
-            # Bytes: a source may be binary (their MATLAB figure), cited without a line.
-            data = subprocess.run(["git", "-C", str(MIRROR), "show", f"{m['commit']}:{m['path']}"],
-                                  capture_output=True, check=True).stdout
-            if m["line"]:
-                assert int(m["last"] or m["line"]) <= len(data.splitlines()), source
+def test_every_cited_file_is_recorded_with_its_blob() -> None:
+    """Each citation names a recorded file (its full commit, git blob, size and lines) and lies inside it."""
+    recorded = audit.recorded_sources()
+    assert sorted(recorded) == audit.cited_files()  # no citation without its record, no record left over
+    checked = lines = 0
+    for section in audit.SECTIONS:
+        for row in audit.audit(section):
+            for source in row.sources:
+                m = audit.SOURCE.match(source)
+                r = recorded[f"{m['path']}@{m['commit']}"]
+                assert r["commit"].startswith(m["commit"]) and re.fullmatch(r"[0-9a-f]{40}", r["commit"]), source
+                assert re.fullmatch(r"[0-9a-f]{40}", r["blob"]), source
+                if r.get("absent"):
+                    # Committed, but the blob is absent from the repository (the row's point): no line to cite.
+                    assert m["line"] is None and r["blob"].startswith("2b2178b"), source
+                elif m["line"]:
+                    assert 1 <= int(m["line"]) <= int(m["last"] or m["line"]) <= r["lines"], source
+                    lines += 1
+                checked += 1
+    assert checked >= 120 and lines >= 100, (checked, lines)
+
+
+def test_recorded_blobs_agree_with_the_data_manifest() -> None:
+    """The files both records hold (the outputs the book draws): the same blob and size at the same commit,
+    read by two tools (tools/record_audit_sources.py, tools/extract_authors_data.py)."""
+    recorded = audit.recorded_sources()
+    manifest = json.loads((Path(A.__file__).parent / "data" / "authors" / "MANIFEST.json").read_text())
+    both = set()
+    for f in manifest["files"].values():
+        for s in f["sources"]:
+            r = recorded.get(f"{s['path']}@{s['commit'][:7]}")
+            if r is not None:
+                assert (r["commit"], r["blob"], r["bytes"]) == (s["commit"], s["blob"], s["bytes"]), s["path"]
+                both.add(s["path"])
+    assert len(both) >= 13, sorted(both)
+
+
+def _git_blob_id(data: bytes) -> str:
+    """Git's object id of a file's bytes: SHA-1 of the header ``blob <size>\\0`` and the bytes."""
+    return hashlib.sha1(b"blob %d\0" % len(data) + data).hexdigest()
+
+
+def test_git_blob_id_is_gits() -> None:
+    assert _git_blob_id(b"") == "e69de29bb2d1d6434b8b29ae775ad8c2e48c5391"  # git hash-object /dev/null
+    # printf 'hello\n' | git hash-object --stdin
+    assert _git_blob_id(b"hello\n") == "ce013625030ba8dba906f756967f9e9ca394464a"
+
+
+def test_recorded_sources_match_the_authors_repository() -> None:
+    """With a copy of the authors' repository (SAFEPG_AUTHORS_MIRROR), each cited file's bytes there hash to
+    the recorded blob, with the recorded size and lines."""
+    where = os.environ.get(MIRROR_VARIABLE)
+    if not where:
+        pytest.skip(f"the authors' repository is not mirrored here: set {MIRROR_VARIABLE} to a clone of "
+                    "T3p/adaptive-batch-size to check the cited blobs against it")
+    mirror = Path(where)
+    assert subprocess.run(["git", "-C", str(mirror), "rev-parse", "--git-dir"], capture_output=True).returncode == 0, (
+        f"{MIRROR_VARIABLE}={where} is not a git repository")
+
+    def git(*args: str, check: bool = True) -> subprocess.CompletedProcess:
+        return subprocess.run(["git", "-C", str(mirror), *args], capture_output=True, check=check)
+
+    checked = 0
+    for cited, r in audit.recorded_sources().items():
+        path, _ = cited.rsplit("@", 1)
+        assert git("rev-parse", "--verify", f"{r['commit']}^{{commit}}").stdout.decode().strip() == r["commit"], cited
+        assert git("rev-parse", f"{r['commit']}:{path}").stdout.decode().strip() == r["blob"], cited
+        data = git("cat-file", "blob", f"{r['commit']}:{path}", check=False)
+        if r.get("absent"):
+            assert data.returncode != 0, f"{cited}: the blob is in the repository after all"
+        else:
+            assert data.returncode == 0, cited
+            assert _git_blob_id(data.stdout) == r["blob"], cited  # the bytes themselves, hashed here
+            assert (len(data.stdout), len(data.stdout.splitlines())) == (r["bytes"], r["lines"]), cited
+        checked += 1
+    assert checked >= 45
 
 
 # ------------------------------------------------------------------ the overlays carry the data

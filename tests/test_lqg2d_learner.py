@@ -10,7 +10,7 @@ import re
 
 import numpy as np
 import pytest
-from ch5_node import NODE, run_page
+from ch5_node import run_page
 
 from safepg.learning import learn
 from safepg.options import Departures, ErrorModel, SafeStep, Vanilla
@@ -28,7 +28,7 @@ from safepg.thesis.explorers.lqg2d_learner import (
 )
 from safepg.thesis.explorers.option_names import learner_options
 
-needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
+needs_node = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 
 
 @pytest.fixture(scope="module")

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import shutil
 import subprocess
 
 import pytest
 
+from conftest import require_node
 from safepg.definition import OPTION_TYPES, from_dict, to_dict
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.thesis.explorers.js_tasks import learner_sources
@@ -25,8 +25,7 @@ from safepg.thesis.explorers.option_names import (
     table_js,
 )
 
-NODE = shutil.which("node")
-needs_node = pytest.mark.skipif(NODE is None, reason="node is not installed")
+needs_node = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 
 METHODS = [Adaptive(), Vanilla(100), Vanilla(100, SafeStep()),
            Adaptive(Gradient("reinforce", False, "raw"), ErrorModel("bernstein", 0.5, "empirical"),
@@ -86,7 +85,7 @@ def test_repeated_flat_names_are_refused(monkeypatch):
 
 
 def _node(script: str, payload: object) -> object:
-    proc = subprocess.run([NODE, "-e", learner_sources() + "\n" + script], input=json.dumps(payload),
+    proc = subprocess.run([require_node(), "-e", learner_sources() + "\n" + script], input=json.dumps(payload),
                           capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)

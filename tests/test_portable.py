@@ -171,7 +171,8 @@ def test_scalar_step_and_upsilon_equal_explicit_arithmetic(seed: int) -> None:
 
 
 def _ref_performance_1d(env: LQG, theta: float, sigma: float) -> float:
-    """SETTINGS.md's closed form, evaluated one IEEE operation at a time in the library's order."""
+    """The 1-D closed form (tests/test_lqg.py's ``j_1d_settings``), evaluated one IEEE operation at a time in
+    the library's order."""
     F = 1.0 + 1.0 * theta
     M = 0.5 * (1.0 + (theta * 1.0) * theta)
     P = M / (1.0 - env.gamma * (F * F))

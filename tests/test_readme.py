@@ -130,12 +130,15 @@ def test_markers_give_a_reason() -> None:
     # A marker that is not directly before a python block (a typo, a block moved) marks nothing.
     text = README.read_text(encoding="utf-8").splitlines()
     marked = {b.line for b in BLOCKS if b.skip is not None}
+    markers = 0
     for i, line in enumerate(text):
         if "not run by tests/test_readme.py" in line:
             assert SKIP.match(line.strip()), f"README.md:{i + 1}: malformed marker {line.strip()!r}"
             nxt = next((j for j in range(i + 1, len(text)) if text[j].strip()), None)
             assert nxt is not None and text[nxt].strip() == "```python" and nxt + 2 in marked, (
                 f"README.md:{i + 1}: the marker is not directly before a ```python block")
+            markers += 1
+    assert markers == len(marked) >= 1  # every marked block was found through its marker
 
 
 @pytest.mark.parametrize("block", RUN, ids=[f"README.md:{b.line}" for b in RUN])

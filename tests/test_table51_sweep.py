@@ -147,7 +147,13 @@ def test_sweep_is_stored_and_reloaded(tmp_path, monkeypatch):
     summary = ts.summarise(rows)
     assert {(s["theta0"], s["count"]) for s in summary} == {(-0.55, "all"), (-0.55, "evaluated"),
                                                             (-0.575, "all"), (-0.575, "evaluated")}
-    assert all(0 <= s["within_all"] <= 24 for s in summary)
+    # Each group's count of cells within 5 points of the printed value, recounted from its 24 rows.
+    for s in summary:
+        group = [r for r in rows if (r["variant"], r["theta0"], r["count"]) == (s["variant"], s["theta0"], s["count"])]
+        assert len(group) == 24
+        assert s["within_all"] == sum(abs(r["difference"]) <= 0.05 for r in group)
+        assert s["within_all"] == s["within_sigma_0.5"] + s["within_sigma_1"]
+    assert len(summary) == 6
     fig = ts.figure_theta0_scan(summary)
     assert len(fig.axes) == 2
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import import_or_fail
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, vanilla_pg
@@ -239,7 +240,7 @@ def test_the_cartpole_declares_its_batches_and_measured_returns():
 
 
 def test_a_gym_task_declares_its_measured_returns():
-    pytest.importorskip("gymnasium")
+    import_or_fail("gymnasium")
     from safepg.envs.gym_task import GymTask
 
     task = GymTask("Pendulum-v1", horizon=5, gamma=0.9, reward_bound=17.0, feature_bound=8.0)

@@ -10,7 +10,6 @@ answers as Math.exp does, also next to the boundary.
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 import tempfile
 from pathlib import Path
@@ -20,11 +19,11 @@ import numpy as np
 import pytest
 from script_module import load
 
+from conftest import import_or_fail, require_node
 from safepg.envs.lqg import LQG
 from safepg.thesis.explorers.js_tasks import learner_sources, lqg_task_data
 
-NODE = shutil.which("node")
-pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")
+pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 ROOT = Path(__file__).resolve().parents[1]
 
 HARNESS = r"""
@@ -64,8 +63,8 @@ def run_node(request: dict[str, Any], *, prelude: str = "") -> dict[str, Any]:
         learner, harness = Path(d) / "learner_all.js", Path(d) / "harness.js"
         learner.write_text(prelude + learner_sources())
         harness.write_text(HARNESS)
-        proc = subprocess.run([NODE, str(harness), str(learner)], input=json.dumps(request), capture_output=True,
-                              text=True, check=False)
+        proc = subprocess.run([require_node(), str(harness), str(learner)], input=json.dumps(request),
+                              capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)
 
@@ -142,7 +141,7 @@ def test_the_shortcut_past_math_exp_answers_as_math_exp() -> None:
 
 
 def test_the_committed_binary_is_what_the_source_compiles_to(tmp_path: Path) -> None:
-    pytest.importorskip("ziglang", reason="the kernel's compiler (requirements-dev.txt) is not installed")
+    import_or_fail("ziglang", "requirements-dev.txt")  # the kernel's compiler
     build = load("tools/build_wasm.py")
     out = tmp_path / "kernel.wasm"
     build.compile_kernel(out)

@@ -13,6 +13,7 @@ numbers a row quotes are recomputed in the chapter that shows it.
 
 from __future__ import annotations
 
+import json
 import re
 import tomllib
 from dataclasses import dataclass, fields
@@ -28,6 +29,9 @@ AUDIT_DIR = Path(__file__).resolve().parent / "data" / "audit"
 SECTIONS = ("5.1", "5.2", "5.3")
 #: ``path@commit`` or ``path@commit:line`` (line or first-last) in the authors' repository.
 SOURCE = re.compile(r"^(?P<path>[\w./-]+)@(?P<commit>[0-9a-f]{7,40})(?::(?P<line>\d+)(?:-(?P<last>\d+))?)?$")
+#: Every file the audit cites, by ``path@commit``: its full commit, git blob, size and line count, read from
+#: the authors' repository by ``tools/record_audit_sources.py`` (so that the citations can be checked without it).
+SOURCES_FILE = AUDIT_DIR / "sources.json"
 
 
 @dataclass(frozen=True)
@@ -72,6 +76,24 @@ def audit(section: str) -> tuple[AuditRow, ...]:
             source_link(s)  # every source must name a path and a commit
         rows.append(AuditRow(**{**row, "sources": tuple(row["sources"])}))
     return tuple(rows)
+
+
+def cited_files() -> list[str]:
+    """Every file the audit cites, as ``path@commit`` (the line part dropped), sorted, each once."""
+    found = set()
+    for section in SECTIONS:
+        for row in audit(section):
+            for s in row.sources:
+                m = SOURCE.match(s)
+                assert m is not None  # audit() checked every source
+                found.add(f"{m['path']}@{m['commit']}")
+    return sorted(found)
+
+
+def recorded_sources() -> dict[str, dict]:
+    """:data:`SOURCES_FILE`: ``{"path@commit": {"commit", "blob", "bytes", "lines"}}``; a file whose blob the
+    repository's history names but does not hold has ``"absent": true`` and no size."""
+    return json.loads(SOURCES_FILE.read_text(encoding="utf-8"))["files"]
 
 
 def audit_table(section: str, name: str) -> Table:

@@ -8,6 +8,7 @@ the book's light and dark themes.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -30,14 +31,20 @@ MUTED = "#7f7f7f"
 ESTIMATOR_COLORS = {"reinforce": MUTED, "gpomdp": ACCENT}
 
 
-def use_style() -> None:
+def use_style(digest: bool = False) -> None:
     """Matplotlib defaults for the book, and high-DPI inline figures in a notebook.
 
     Under IPython, figures are shown as PNGs at twice the resolution (``"retina"``) with
     their display size recorded, so they stay sharp on high-density screens and when the
     browser zooms, and the book's pages keep their layout. No titles are drawn: the book
-    numbers and captions its figures.
+    numbers and captions its figures. matplotlib's warning that a legend's automatic placement
+    was slow is silenced (it depends on the machine's load, not on the figure). With
+    ``digest``, each figure's text form, which nbval compares and the book does not show, is
+    what it plots (:func:`safepg.thesis.figure_digest.digest_figures`).
     """
+    # matplotlib warns when placing a legend at loc="best" took more than a second of wall time: on a busy
+    # machine a figure cell then writes to stderr, and nbval fails it for that alone (a clock in the tests).
+    warnings.filterwarnings("ignore", message='Creating legend with loc="best" can be slow', category=UserWarning)
     mpl.rcParams.update({
         "figure.facecolor": "white", "axes.facecolor": "white", "savefig.facecolor": "white",
         "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False,
@@ -51,6 +58,10 @@ def use_style() -> None:
         from matplotlib_inline.backend_inline import set_matplotlib_formats
 
         set_matplotlib_formats("retina")
+        if digest:
+            from safepg.thesis.figure_digest import digest_figures
+
+            digest_figures()
 
 
 def estimator_style(estimator: str) -> dict[str, Any]:
