@@ -285,7 +285,8 @@ def _mean_sd(values: Sequence[float] | np.ndarray) -> tuple[float, float, int]:
 def _covariance(y: np.ndarray) -> np.ndarray:
     """Sample covariance (ddof = 1) of the rows of ``y`` (n, B), elementwise and in a fixed order."""
     centred = y - y.mean(axis=0)
-    return np.asarray(np.einsum("ni,nj->ij", centred, centred, optimize=False) / (y.shape[0] - 1))
+    # Elementwise products and NumPy's pairwise sum: no BLAS, no CPU-dispatched kernel (safepg.portable).
+    return np.asarray((centred[:, :, None] * centred[:, None, :]).sum(axis=0) / (y.shape[0] - 1))
 
 
 def _quadratic(s: np.ndarray, v: np.ndarray) -> float:
@@ -641,7 +642,7 @@ def _hotelling_two_sample(groups: np.ndarray, mask: np.ndarray) -> np.ndarray:
     first = (mask[:, :, None] * groups[None, :, :]).sum(axis=1) / m
     second = ((~mask)[:, :, None] * groups[None, :, :]).sum(axis=1) / (n - m)
     dev = np.where(mask[:, :, None], groups[None, :, :] - first[:, None, :], groups[None, :, :] - second[:, None, :])
-    s = np.einsum("sni,snj->sij", dev, dev, optimize=False) / (n - 2)
+    s = (dev[:, :, :, None] * dev[:, :, None, :]).sum(axis=1) / (n - 2)
     d = first - second
     w = (m[:, 0] * (n - m[:, 0]) / n)
     if b == 1:
