@@ -40,7 +40,7 @@ def test_definitions_match_the_thesis():
                for c in t51.configs)
     printed = ex.get_experiment("table-5.1-printed-theta0")
     assert [replace(c, theta0=(-0.575,)) for c in printed.configs] == list(t51.configs)
-    assert len(t52.configs) == 12 and t52.seeds == 5
+    assert len(t52.configs) == 12 and t52.seeds == ex.CURVE_SEEDS  # it feeds the curves of Figures 5.1-5.4
     assert all(c.budget == 30_000_000 and c.theta0 == (0.0,) and c.sigma == 1.0 for c in t52.configs)
     assert sum(c.method.gradient.estimator == "reinforce" for c in t52.configs) == 3
     assert len({c.key() for c in t52.configs}) == 12
@@ -277,3 +277,16 @@ def test_authors_experiment_runs_and_is_counted_their_way(root):
     rec = es.run_experiment(lqg, jobs=1, progress=False)[lqg.configs[0].name][0]
     row = rp.report(lqg, {lqg.configs[0].name: [rec]})["configs"][0]
     assert row["improvement_ratio"]["mean"] == strict_improvement_ratio(rec.J[:-1])  # 5 of 6 batch starts
+
+
+def test_experiments_start_with_the_seed_rule_s_counts() -> None:
+    """An experiment whose runs feed a whole curve of the scorecard starts with the rule's count for curves;
+    the others the count for one run (safepg.thesis.seed_rule)."""
+    from safepg.thesis.curve_bands import CURVE_EXPERIMENTS
+    from safepg.thesis.seed_rule import START_SEEDS
+
+    assert START_SEEDS["whole curve"] == ex.CURVE_SEEDS > START_SEEDS["one run"] == 5
+    for name in CURVE_EXPERIMENTS:
+        assert ex.get_experiment(name).seeds == ex.CURVE_SEEDS, name
+    for name in ("table-5.1", "table-5.1-authors", "table-5.2-lemma-range", "cartpole-baseline", "table-5.4-authors"):
+        assert ex.get_experiment(name).seeds == START_SEEDS["one run"], name
