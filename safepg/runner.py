@@ -234,8 +234,8 @@ def seeds_of(seeds: Seeds, name: str) -> int:
 
 def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.PathLike[str],
                  on_damaged: OnDamaged = "warn", first_seed: int = 0) -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``configs`` by config name (missing seeds are left out): seeds
-    ``first_seed .. first_seed + n - 1``, n the config's count in ``seeds``.
+    """Finished runs of ``configs`` by config name, n seeds each from ``first_seed`` on (n its count in
+    ``seeds``); missing seeds are left out.
 
     Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
     read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
