@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from safepg.thesis.explorers.component import static_text
+from safepg.explorers.component import static_text
 
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed")

@@ -484,7 +484,7 @@ def safety_plan(root: Path) -> list[tuple[str, Any, np.ndarray, tuple[int, ...]]
 def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
                     interval: float | None = None, book: Path = BOOK) -> str:
     """The cart-pole chapter's safety measurements, run by run, with the chapter's processes per run."""
-    from safepg.thesis.safety_store import is_measured, measure_runs
+    from safepg.safety_store import is_measured, measure_runs
 
     stream = stream or sys.stdout
     folder = root / "safety-mc"
