@@ -218,8 +218,9 @@ def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
 
 
 def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
-                 on_damaged: OnDamaged = "warn") -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``configs`` by config name (missing seeds are left out).
+                 on_damaged: OnDamaged = "warn", first_seed: int = 0) -> dict[str, list[LearningRecord]]:
+    """Finished runs of ``configs`` by config name (missing seeds are left out): seeds
+    ``first_seed .. first_seed + seeds - 1``.
 
     Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
     read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
@@ -228,7 +229,7 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
     damaged = []
     for c in configs:
         recs = []
-        for seed in range(seeds):
+        for seed in range(first_seed, first_seed + seeds):
             try:
                 recs.append(stored_run(folder, c, seed, on_damaged))
             except DamagedRunsError as err:
@@ -241,13 +242,29 @@ def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.Path
 
 @dataclass(frozen=True)
 class RunGroup:
-    """The runs of one folder of the store: each of ``configs`` for ``seeds`` seeds (0, 1, ...),
-    the warm-started ones from ``starts`` (by config name, seed by seed)."""
+    """The runs of one folder of the store: each of ``configs`` for ``seeds`` seeds (``first_seed``,
+    ``first_seed + 1``, ...), the warm-started ones from ``starts`` (by config name, seed by seed).
+
+    A ``first_seed`` above 0 gives runs that share no seed with the group's seeds 0, 1, ...: a step
+    size chosen on them leaves those seeds unseen (:mod:`safepg.comparison`).
+    """
 
     configs: Sequence[RunConfig]
     seeds: int
     folder: Path
     starts: Mapping[str, Sequence[np.ndarray]] = field(default_factory=dict)
+    first_seed: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.first_seed, bool) or int(self.first_seed) != self.first_seed or self.first_seed < 0:
+            raise ValueError(f"first_seed must be an integer >= 0, got {self.first_seed!r}")
+        if self.first_seed and any(c.warm_start is not None for c in self.configs):
+            raise ValueError("first_seed must be 0 for warm-started configs (their starts are given seed by seed)")
+
+    @property
+    def seed_range(self) -> range:
+        """The seeds of the group."""
+        return range(self.first_seed, self.first_seed + self.seeds)
 
 
 def run_configs(
@@ -258,6 +275,7 @@ def run_configs(
     jobs: int = -1,
     progress: bool = True,
     desc: str | None = None,
+    first_seed: int = 0,
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) and return all records by config name.
 
@@ -283,8 +301,10 @@ def run_configs(
         joblib's ``n_jobs``: a positive count, or -1 for every core (-2 all but one, ...).
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
+    first_seed
+        The first seed: the seeds are ``first_seed .. first_seed + seeds - 1``.
     """
-    group = RunGroup(configs, seeds, Path(folder), starts or {})
+    group = RunGroup(configs, seeds, Path(folder), starts or {}, first_seed)
     return run_groups([group], jobs, progress, desc or Path(folder).name)[0]
 
 
@@ -309,7 +329,7 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
     for k, g in enumerate(groups):
         # Files a killed runner was writing; a live runner's are kept.
         remove_stale_temp_files(g.folder)
-        todo += [(k, c, seed) for c in g.configs for seed in range(g.seeds)
+        todo += [(k, c, seed) for c in g.configs for seed in g.seed_range
                  if stored_run(g.folder, c, seed, "set_aside") is None]
     # Longest runs first, so that no long run is dispatched last and leaves the other workers
     # idle at the end: the largest budgets; among equal budgets the adaptive runs (a Python
@@ -339,7 +359,7 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
             if runs:
                 share = worked[k] / sum(worked) if sum(worked) > 0 else runs / len(todo)
                 record_timing(g.folder, wall * share, runs, n_jobs)
-    return [load_configs(g.configs, g.seeds, g.folder) for g in groups]
+    return [load_configs(g.configs, g.seeds, g.folder, first_seed=g.first_seed) for g in groups]
 
 
 def _shape(d: Any) -> Any:
