@@ -205,6 +205,9 @@ class ComparisonResult:
         Each method's runs' evaluated returns (final parameters on the M evaluation episodes).
     start_score : float
         The start's evaluated return on the same episodes.
+    start_standard_error : float
+        The standard error of that mean over the M episodes: how far from J a policy's evaluated
+        return may lie (the runs' differences are paired: measured on the same episodes).
     safety : dict
         Each adaptive variant's measurement of every update that moved theta, one per run.
     """
@@ -215,6 +218,7 @@ class ComparisonResult:
     records: dict[str, list[LearningRecord]]
     scores: dict[str, np.ndarray]
     start_score: float
+    start_standard_error: float
     safety: dict[str, list[MonteCarloOutcomes]]
 
     def summary(self, reps: int = BOOTSTRAP_REPS, seed: int = 0) -> list[dict[str, Any]]:
@@ -323,7 +327,19 @@ def run_comparison(cmp: Comparison, root: Path, jobs: int = -1, progress: bool =
     scores = {name: final_returns(cmp.task, np.array([r.theta_final for r in records[name]]), cmp.sigma,
                                   cmp.episodes, cmp.eval_seed) for name in order}
     start = float(final_returns(cmp.task, np.asarray(cmp.theta0), cmp.sigma, cmp.episodes, cmp.eval_seed)[0])
-    return ComparisonResult(cmp, steps, scores_by_step, {n: records[n] for n in order}, scores, start, safety)
+    return ComparisonResult(cmp, steps, scores_by_step, {n: records[n] for n in order}, scores, start,
+                            _standard_error(cmp), safety)
+
+
+def _standard_error(cmp: Comparison) -> float:
+    """The sample standard deviation of the start's M evaluation returns over sqrt(M) (exact sums)."""
+    policy = LinearGaussianPolicy(np.asarray(cmp.theta0, dtype=float).reshape(1, -1), cmp.sigma)
+    if isinstance(cmp.task, Pendulum):
+        x = cmp.task.episode_returns(policy, cmp.episodes, cmp.eval_seed)[1]
+    else:
+        x = cmp.task.simulate(policy, cmp.episodes, cmp.eval_seed).rewards.sum(axis=1)
+    m = portable.fsum_mean(x)
+    return math.sqrt(math.fsum(((x - m) * (x - m)).tolist()) / (x.size - 1)) / math.sqrt(x.size)
 
 
 def is_computed(cmp: Comparison, root: Path) -> bool:
