@@ -9,7 +9,10 @@ r"""What the book's chapters compute, computed before ``jupyter-book build``, wi
 - ``run_sweep(...)``: the cart-pole sweep's baseline searches (``SWEEP_SEEDS`` seeds), then
   ``cartpole-sweep``;
 - ``sweep_paths(...)``: the Table 5.1 sweep (its literal keyword arguments kept);
-- ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`).
+- ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`);
+- ``run_comparison(pendulum_comparison(...))``: the pendulum chapter's comparison
+  (:func:`safepg.comparison.run_comparison`: its step search, its runs and their safety
+  measurements), with the literal keyword arguments of ``pendulum_comparison``.
 
 Each is computed into the store the notebooks read (``results/`` beside ``book/``, their
 ``Path("..") / "results"``) by the very functions the notebooks call, with the same joblib
@@ -55,6 +58,8 @@ TTY_INTERVAL = 1.0
 PREFIX = "run-book"
 #: The store's folder of the time :func:`safepg.runner.compile_once` took (its ``timing.jsonl``).
 COMPILE_ONCE = "compile-once"
+#: The name of the pendulum chapter's comparison task (and its folder of the store).
+COMPARISON = "pendulum"
 
 
 @dataclass(frozen=True)
@@ -62,8 +67,9 @@ class Task:
     """One stored computation a chapter needs.
 
     ``kind`` is ``"experiment"`` (``name`` in the registry, run for ``seeds`` seeds),
-    ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``) or
-    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements).
+    ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``),
+    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements) or ``"comparison"`` (``options``:
+    the keyword arguments of :func:`safepg.comparison.pendulum_comparison`).
     """
 
     chapter: str
@@ -147,6 +153,9 @@ def chapter_requests(notebook: Path) -> list[Task]:
                                   options=_literal_keywords(call, ("jobs", "seeds", "budget"))))
             elif name == "measure_runs":
                 tasks.append(Task(chapter, "safety-mc", "safety-mc"))
+            elif name == "pendulum_comparison":
+                tasks.append(Task(chapter, COMPARISON, "comparison",
+                                  options=_literal_keywords(call, ("seeds", "budget", "episodes"))))
     return tasks
 
 
@@ -507,12 +516,52 @@ def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: b
     return "computed"
 
 
+def _comparison(task: Task) -> Any:
+    from safepg.comparison import pendulum_comparison
+
+    return pendulum_comparison(**dict(task.options))
+
+
+def prefetch_comparison(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
+                        tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
+    """The pendulum chapter's comparison (:func:`safepg.comparison.run_comparison`): its step search,
+    runs and safety measurements; ``"stored"`` or ``"computed"``."""
+    from safepg.comparison import is_computed, run_comparison
+
+    stream = stream or sys.stdout
+    cmp = _comparison(task)
+    if is_computed(cmp, root):
+        _say(stream, f"{task.name}: stored (its comparison: the step search, the runs, their safety)")
+        return "stored"
+    progress = Progress(task.name, 3, 0, 3.0, unit="stages", stream=stream, tty=tty, interval=interval,
+                        previous_s=previous_seconds(book, task.name))
+    try:
+        def stage(line: str) -> None:
+            progress.note(f"{task.name}: {line}")
+            progress.advance(0, 1.0)
+
+        run_comparison(cmp, root, jobs, report=stage)
+    except BaseException:
+        progress.close(finished=False)
+        raise
+    progress.close()
+    return "computed"
+
+
 def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
-    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute."""
+    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute
+    (and of the pendulum's comparison, if it has)."""
     from joblib import effective_n_jobs
+
+    from safepg.comparison import is_computed
 
     configs = []
     for t in tasks:
+        if t.kind == "comparison":
+            cmp = _comparison(t)
+            if not is_computed(cmp, root):
+                configs += [*cmp.adaptive, *cmp.search_configs()]
+            continue
         if t.kind == "experiment":
             exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
             folder = experiment_folder(exp, root)
@@ -548,6 +597,8 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
             continue
         if t.kind == "table-5.1-sweep":
             done[t.name] = prefetch_sweep(t, root, **kw)
+        elif t.kind == "comparison":
+            done[t.name] = prefetch_comparison(t, root, jobs=jobs, **kw)
         else:
             done[t.name] = prefetch_safety(t, root, **kw)
     computed = sum(v == "computed" for v in done.values())
