@@ -395,6 +395,12 @@ def guarantee_costs(task: Any, sigma: float, g: float, sample_variance: float, s
     return rows
 
 
+def updated_gradients(records: Sequence[LearningRecord]) -> np.ndarray:
+    r""":math:`|\hat g_k|` of every update of ``records``, run after run: the gradient component each
+    update was about (the largest one of the batch's estimate)."""
+    return np.concatenate([np.abs(r.grad[np.arange(r.iterations), np.maximum(r.coordinate, 0)]) for r in records])
+
+
 def update_terms(records: Sequence[LearningRecord]) -> dict[str, Any]:
     r"""Why an adaptive method moves theta or not, in numbers, over the updates of ``records``.
 
@@ -404,7 +410,7 @@ def update_terms(records: Sequence[LearningRecord]) -> dict[str, Any]:
     updates with :math:`\epsilon < |\hat g_k|` (the guarded step moves only there), and the largest
     distance the runs' theta moved from its start (the infinity norm).
     """
-    g = np.concatenate([np.abs(r.grad[np.arange(r.iterations), np.maximum(r.coordinate, 0)]) for r in records])
+    g = updated_gradients(records)
     eps = np.concatenate([r.eps for r in records])
     alpha = np.concatenate([r.alpha for r in records])
     return {"c": float(records[0].config["c"]), "updates": int(g.size),
@@ -459,4 +465,4 @@ def pendulum_comparison(seeds: int = 20, budget: int = PENDULUM_BUDGET, episodes
 
 __all__ = ["Comparison", "ComparisonResult", "PENDULUM_ALPHAS", "PENDULUM_BUDGET", "StepSearch", "choose_steps",
            "final_returns", "guarantee_costs", "is_computed", "pendulum_comparison", "run_comparison",
-           "update_terms"]
+           "update_terms", "updated_gradients"]

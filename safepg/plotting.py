@@ -7,7 +7,11 @@ values). The reproduction adds the thesis's line styles per estimator (:mod:`saf
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+from typing import Any
+
 import matplotlib as mpl
+import numpy as np
 
 BOUND_COLORS = {
     ("chebyshev", False): "#3b6fb6",
@@ -55,4 +59,69 @@ def bound_label(bound: str, empirical_range: bool = False) -> str:
     return BOUND_LABELS[bound] + (" (e.r.)" if empirical_range else "")
 
 
-__all__ = ["ACCENT", "BOUND_COLORS", "BOUND_LABELS", "MUTED", "bound_color", "bound_label", "use_style"]
+def figure_upsilon(bounds: Sequence[tuple[str, bool, Any]], g: float, c: float, budget: int | None = None,
+                   n: np.ndarray | None = None) -> Any:
+    r"""Upsilon_delta(N) of several bounds against N (log-log), each in its bound's colour.
+
+    Parameters
+    ----------
+    bounds : sequence of (bound, empirical range, ErrorBound)
+        The curves, e.g. ``("bernstein", True, bernstein(0.95, S, r))``.
+    g : float
+        The gradient magnitude.
+    c : float
+        The penalty constant.
+    budget : int, optional
+        Drawn as a dotted vertical line, labelled as one run's budget.
+    n : array, optional
+        The batch sizes (default: 10 to 10^13).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Zero values (eps(N) >= g) are not drawn.
+    """
+    import matplotlib.pyplot as plt
+
+    from safepg.meta import upsilon
+
+    N = np.geomspace(10, 1e13, 400) if n is None else np.asarray(n, dtype=float)
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    for bound, empirical, bd in bounds:
+        U = np.asarray(upsilon(N, g, bd, c))
+        ax.plot(N, np.where(U > 0, U, np.nan), color=bound_color(bound, empirical), label=bound_label(bound, empirical))
+    if budget is not None:
+        ax.axvline(budget, color=MUTED, linestyle=":", linewidth=1)
+        ax.text(budget * 1.3, 0.02, "one run's budget", transform=ax.get_xaxis_transform(), color=MUTED,
+                fontsize="small")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("batch size N (trajectories)")
+    ax.set_ylabel(r"$\Upsilon_\delta(N)$")
+    ax.legend(fontsize="small", loc="lower left")
+    fig.tight_layout()
+    return fig
+
+
+def figure_scores(scores: Mapping[str, np.ndarray], labels: Mapping[str, str], highlighted: Sequence[str] = (),
+                  reference: float | None = None, xlabel: str = "final policy's return") -> Any:
+    """One row of dots per method, one dot per run's score; the ``highlighted`` methods in the accent
+    colour, a dotted vertical line at ``reference`` (e.g. the start's score)."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 0.45 * len(scores) + 1.0))
+    for i, (name, x) in enumerate(scores.items()):
+        x = np.asarray(x, dtype=float)
+        ax.plot(x, i + np.linspace(-0.25, 0.25, x.size), "o", markersize=3,
+                color=ACCENT if name in highlighted else MUTED)
+    if reference is not None:
+        ax.axvline(reference, color="black", linestyle=":", linewidth=1)
+    ax.set_yticks(range(len(scores)), [labels.get(n, n) for n in scores], fontsize="small")
+    ax.invert_yaxis()
+    ax.set_xlabel(xlabel)
+    fig.tight_layout()
+    return fig
+
+
+__all__ = ["ACCENT", "BOUND_COLORS", "BOUND_LABELS", "MUTED", "bound_color", "bound_label", "figure_scores",
+           "figure_upsilon", "use_style"]

@@ -149,4 +149,16 @@ def upsilon_explorer(task: Any, theta: np.ndarray | float, sigmas: Sequence[floa
         "\n" + static_text("upsilon_compute.js"), compute_py, data)
 
 
-__all__ = ["BOUND_CHOICES", "TITLE", "sample_spread", "upsilon_explorer"]
+def pendulum_upsilon_explorer(n: int = 5000, seed: int = 0) -> Explorer:
+    """:func:`upsilon_explorer` on :class:`~safepg.envs.pendulum.Pendulum` (the pendulum chapter's):
+    the empirical bounds' variance and range from batches of ``n`` episodes at theta = 0 (G(PO)MDP
+    with its baseline, the score of the sampled action) on a grid of sigma from 0.5 to 2, and
+    ||g||_inf from 50 to 3000, starting at 900, about the gradients the chapter's runs meet."""
+    from safepg.envs.pendulum import Pendulum
+
+    return upsilon_explorer(Pendulum(), np.zeros(3), np.round(np.linspace(0.5, 2.0, 7), 2), n=n, seed=seed,
+                            gradient=Gradient(score_action="raw"), g_slider=(50.0, 3000.0, 50.0, 900.0),
+                            title="Upsilon_delta(N) for the pendulum (Section 4.3)")
+
+
+__all__ = ["BOUND_CHOICES", "TITLE", "pendulum_upsilon_explorer", "sample_spread", "upsilon_explorer"]

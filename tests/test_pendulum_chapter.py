@@ -1,0 +1,67 @@
+"""The pendulum chapter imports only the library, sits in its own part after Chapter 5, and its
+campaign is found by run-book."""
+
+from __future__ import annotations
+
+import ast
+import json
+from pathlib import Path
+
+import pytest
+
+from safepg.thesis import prefetch
+
+ROOT = Path(__file__).resolve().parents[1]
+CHAPTER = ROOT / "book" / "pendulum.ipynb"
+
+
+def imported_modules(notebook: Path) -> list[str]:
+    """Every module a code cell imports (``import a.b``, ``from a.b import c``: ``a.b`` and ``a.b.c``)."""
+    found = []
+    for cell in json.loads(notebook.read_text())["cells"]:
+        if cell["cell_type"] != "code":
+            continue
+        src = "".join(cell["source"])
+        src = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in src.splitlines())
+        for node in ast.walk(ast.parse(src)):
+            if isinstance(node, ast.Import):
+                found += [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                module = node.module or ""
+                found += [module] + [f"{module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Call) and getattr(node.func, "id", None) == "__import__":
+                found += [a.value for a in node.args if isinstance(a, ast.Constant) and isinstance(a.value, str)]
+    return found
+
+
+def thesis_imports(notebook: Path) -> list[str]:
+    return [m for m in imported_modules(notebook) if m == "safepg.thesis" or m.startswith("safepg.thesis.")]
+
+
+def test_the_chapter_imports_only_the_library() -> None:
+    modules = imported_modules(CHAPTER)
+    assert any(m.startswith("safepg.") for m in modules)
+    assert thesis_imports(CHAPTER) == []
+
+
+@pytest.mark.parametrize("line", ["from safepg.thesis import plotting", "import safepg.thesis.safety",
+                                  "from safepg import thesis", "x = __import__('safepg.thesis.report')"])
+def test_the_import_check_fails_on_a_thesis_import(tmp_path: Path, line: str) -> None:
+    nb = json.loads(CHAPTER.read_text())
+    nb["cells"].append({"cell_type": "code", "metadata": {}, "source": [line], "outputs": [], "execution_count": None})
+    path = tmp_path / "pendulum.ipynb"
+    path.write_text(json.dumps(nb))
+    assert thesis_imports(path)
+
+
+def test_the_chapter_is_its_own_part_after_chapter_5() -> None:
+    toc = (ROOT / "_toc.yml").read_text()
+    assert toc.index("book/cartpole") < toc.index("caption: Beyond the thesis") < toc.index("book/pendulum")
+    stems = [p.stem for p in prefetch.chapters(ROOT / "book")]
+    assert stems[stems.index("cartpole") + 1] == "pendulum"
+
+
+def test_run_book_finds_the_chapters_campaign() -> None:
+    tasks = prefetch.chapter_requests(CHAPTER)
+    assert [(t.name, t.kind) for t in tasks] == [(prefetch.COMPARISON, "comparison")]
+    assert any(t.kind == "comparison" for t in prefetch.book_tasks(ROOT / "book"))
