@@ -174,7 +174,7 @@ def final_returns(task: Any, thetas: np.ndarray, sigma: float, episodes: int, se
     Every row of ``thetas`` is judged on the episodes that ``seed`` draws: the same starts and the
     same standard normals (common random numbers), so that two policies differ by their own merit
     and not by their luck. The pendulum's kernel gives the returns; another task simulates. The
-    mean is exactly rounded (:func:`safepg.portable.fsum_mean`).
+    mean is exactly rounded (:func:`!safepg.portable.fsum_mean`).
     """
     T = np.atleast_2d(np.asarray(thetas, dtype=float))
     out = np.empty(T.shape[0])
@@ -290,7 +290,7 @@ def run_comparison(cmp: Comparison, root: Path, jobs: int = -1, progress: bool =
 
     The step search and the adaptive variants are dispatched together; then the fixed-batch
     methods (their fixed step comes from the search); then the safety measurements of the
-    adaptive runs, each stored once (:func:`safepg.safety_store.measure_runs`). Everything is seeded:
+    adaptive runs, each stored once (:func:`!safepg.safety_store.measure_runs`). Everything is seeded:
     the same call gives the same numbers, and a stored run or measurement is read, not recomputed.
 
     Parameters

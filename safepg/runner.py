@@ -219,8 +219,8 @@ def _compute_task(i: int, cfg: RunConfig, seed: int, theta0: np.ndarray | None,
 
 def load_configs(configs: Sequence[RunConfig], seeds: int, folder: str | os.PathLike[str],
                  on_damaged: OnDamaged = "warn", first_seed: int = 0) -> dict[str, list[LearningRecord]]:
-    """Finished runs of ``configs`` by config name (missing seeds are left out): seeds
-    ``first_seed .. first_seed + seeds - 1``.
+    """Finished runs of ``configs`` by config name (missing seeds are left out), seeds ``first_seed``
+    to ``first_seed + seeds - 1``.
 
     Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
     read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
@@ -302,7 +302,7 @@ def run_configs(
     progress, desc
         tqdm progress bar and its label (default: the folder's name).
     first_seed
-        The first seed: the seeds are ``first_seed .. first_seed + seeds - 1``.
+        The first seed: the seeds are ``first_seed`` to ``first_seed + seeds - 1``.
     """
     group = RunGroup(configs, seeds, Path(folder), starts or {}, first_seed)
     return run_groups([group], jobs, progress, desc or Path(folder).name)[0]

@@ -353,7 +353,7 @@ class MonteCarloOutcomes:
                    joined("outcome"), looks=parts[0].looks, alpha=parts[0].alpha, steps=sum(p.steps for p in parts))
 
     def to_json(self) -> dict[str, Any]:
-        """JSON-ready form (:meth:`from_json` reads it back)."""
+        """JSON-ready form (:meth:`!from_json` reads it back)."""
         return {"updates": self.updates.tolist(), "change": self.change.tolist(), "lower": self.lower.tolist(),
                 "upper": self.upper.tolist(), "rollouts": self.rollouts.tolist(), "outcome": self.outcome.tolist(),
                 "looks": list(self.looks), "alpha": self.alpha, "steps": int(self.steps)}

@@ -194,7 +194,7 @@ def interquartile_mean(values: Iterable[float]) -> float:
 
     rliable's ``aggregate_iqm``, ``scipy.stats.trim_mean(scores, proportiontocut=0.25)``: of n
     scores sorted, :math:`\lfloor n/4 \rfloor` are cut at each end and the rest averaged (exactly
-    rounded: :func:`math.fsum`).
+    rounded: :func:`!math.fsum`).
     """
     x = np.sort(_scores(values))
     low, high = _trim(x.size)

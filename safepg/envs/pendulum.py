@@ -206,13 +206,13 @@ class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
 
     # ------------------------------------------------------------------ dynamics
     def step(self, state: np.ndarray, torque: np.ndarray | float) -> np.ndarray:
-        """:func:`step_dynamics` with this task's constants (the torque is not clipped)."""
+        """:func:`safepg.envs.pendulum.step_dynamics` with this task's constants (the torque is not clipped)."""
         return step_dynamics(state, torque, gravity=self.gravity, mass=self.mass, length=self.length, dt=self.dt,
                              max_speed=self.max_speed)
 
     @staticmethod
     def reward(state: np.ndarray, torque: np.ndarray | float) -> np.ndarray:
-        """:func:`step_reward`: the reward of a step from ``state`` with the applied ``torque``."""
+        """:func:`safepg.envs.pendulum.step_reward`: the reward of a step from ``state`` with the applied ``torque``."""
         return step_reward(state, torque)
 
     @staticmethod
@@ -236,7 +236,7 @@ class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
     def simulate(self, policy: LinearGaussianPolicy, n: int, rng: RNGLike = None) -> Trajectories:
         """``n`` episodes of H steps under ``policy``, as whole arrays (the reference path).
 
-        Trajectory i reads stream i of one batch key from ``rng`` (:mod:`safepg.streams`): two
+        Trajectory i reads stream i of one batch key from ``rng`` (:mod:`!safepg.streams`): two
         uniforms for its start, then one standard normal per step, the numbers
         :meth:`gradient_batch`'s kernel draws. The loop runs over time; each step is whole-array
         work on the n pendulums.
