@@ -450,16 +450,19 @@ def pendulum_comparison(seeds: int = 20, budget: int = PENDULUM_BUDGET, episodes
     gradient = Gradient(score_action="raw")
     task = Pendulum()
     er = ErrorModel("bernstein", 0.95, "empirical")
-    base = dict(task=task, theta0=(0.0, 0.0, 0.0), sigma=1.0, budget=budget)
+    start = (0.0, 0.0, 0.0)
+
+    def run(name: str, method: Adaptive, on: Pendulum = task) -> RunConfig:
+        return RunConfig(name, method=method, task=on, theta0=start, sigma=1.0, budget=budget)
+
     adaptive = (
-        RunConfig("algorithm-4.1-chebyshev", method=Adaptive(gradient, ErrorModel("chebyshev", 0.95),
-                                                             Batches(100, 100_000)), **base),
-        RunConfig("algorithm-4.1-bernstein-er", method=Adaptive(gradient, er, Batches(100, 100_000)), **base),
-        RunConfig("authors-relaxations", method=Adaptive(gradient, er, Batches(10, 100_000, first=1000),
-                                                         Departures(True, True, True)),
-                  **{**base, "task": replace(task, gamma=1.0, constants_gamma=0.9)}),
+        run("algorithm-4.1-chebyshev", Adaptive(gradient, ErrorModel("chebyshev", 0.95), Batches(100, 100_000))),
+        run("algorithm-4.1-bernstein-er", Adaptive(gradient, er, Batches(100, 100_000))),
+        run("authors-relaxations", Adaptive(gradient, er, Batches(10, 100_000, first=1000),
+                                            Departures(True, True, True)),
+            replace(task, gamma=1.0, constants_gamma=0.9)),
     )
-    return Comparison("pendulum", task, (0.0, 0.0, 0.0), 1.0, budget, gradient, adaptive, (100, 1000),
+    return Comparison("pendulum", task, start, 1.0, budget, gradient, adaptive, (100, 1000),
                       SafeStep("coordinate", er), StepSearch(PENDULUM_ALPHAS), seeds, episodes)
 
 
