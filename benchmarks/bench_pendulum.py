@@ -108,7 +108,9 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--skip-campaign", action="store_true")
     args = ap.parse_args()
-    result: dict[str, object] = {"date": time.strftime("%Y-%m-%d %H:%M"), "cpu": cpu(), "N": N, "H": H}
+    # The host is shared: the load before and after says whether another program ran meanwhile.
+    result: dict[str, object] = {"date": time.strftime("%Y-%m-%d %H:%M"), "cpu": cpu(), "N": N, "H": H,
+                                 "load_average_1min_at_start": os.getloadavg()[0]}
     kernels = {}
     with tempfile.TemporaryDirectory() as tmp:
         for setting, env in (("host", {}), ("haswell", {"NUMBA_CPU_NAME": "haswell"})):
@@ -119,11 +121,13 @@ def main() -> None:
             result["campaign_from_empty"] = run(CAMPAIGN, [f"{tmp}/results"],
                                                 {"NUMBA_CPU_NAME": "haswell", "NUMBA_CACHE_DIR": f"{tmp}/campaign"})
     both = str(kernels["haswell"]["threads"])
+    result["load_average_1min_at_end"] = os.getloadavg()[0]
     ours = float(kernels["haswell"]["steps_per_s"][both])  # type: ignore[index]
     result["speedup_over_gym_task"] = ours / float(result["gym_task_steps_per_s"])  # type: ignore[arg-type]
     OUT.write_text(json.dumps(result, indent=1) + "\n")
     c = result["cpu"]
-    print(f"CPU: {c['model']} ({c['cores']} cores, AVX2 {c['avx2']}, AVX-512 {c['avx512f']})")  # type: ignore[index]
+    print(f"CPU: {c['model']} ({c['cores']} cores, AVX2 {c['avx2']}, AVX-512 {c['avx512f']}); load average "  # type: ignore[index]
+          f"{result['load_average_1min_at_start']:.2f} before, {result['load_average_1min_at_end']:.2f} after")
     for setting, k in kernels.items():
         rates = ", ".join(f"{t} thread(s) {float(v):.3g}" for t, v in k["steps_per_s"].items())  # type: ignore[attr-defined]
         print(f"fused learning kernel, numba for {setting}: {rates} steps/s (compiled in {k['compile_s']:.1f} s)")

@@ -525,26 +525,17 @@ def _comparison(task: Task) -> Any:
 def prefetch_comparison(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
                         tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
     """The pendulum chapter's comparison (:func:`safepg.comparison.run_comparison`): its step search,
-    runs and safety measurements; ``"stored"`` or ``"computed"``."""
+    runs and safety measurements, a line as each ends; ``"stored"`` or ``"computed"``."""
     from safepg.comparison import is_computed, run_comparison
 
-    stream = stream or sys.stdout
-    cmp = _comparison(task)
+    stream, cmp = stream or sys.stdout, _comparison(task)
     if is_computed(cmp, root):
         _say(stream, f"{task.name}: stored (its comparison: the step search, the runs, their safety)")
         return "stored"
-    progress = Progress(task.name, 3, 0, 3.0, unit="stages", stream=stream, tty=tty, interval=interval,
-                        previous_s=previous_seconds(book, task.name))
-    try:
-        def stage(line: str) -> None:
-            progress.note(f"{task.name}: {line}")
-            progress.advance(0, 1.0)
-
-        run_comparison(cmp, root, jobs, report=stage)
-    except BaseException:
-        progress.close(finished=False)
-        raise
-    progress.close()
+    started = time.monotonic()
+    _say(stream, f"{task.name}: computing its step search, its runs and their safety measurements")
+    run_comparison(cmp, root, jobs, report=lambda line: _say(stream, f"{task.name}: {line}"))
+    _say(stream, f"{task.name}: done in {_duration(time.monotonic() - started)}")
     return "computed"
 
 
