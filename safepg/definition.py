@@ -39,7 +39,7 @@ OPTION_TYPES: dict[str, type] = {cls.__name__: cls for cls in (Adaptive, Vanilla
                                                                Departures, FixedStep, SafeStep, Target)}
 #: The core's tasks, by the short name their dictionaries carry (imported when read).
 TASK_TYPES: dict[str, str] = {"LQG": "safepg.envs.lqg:LQG", "CartPole": "safepg.envs.cartpole:CartPole",
-                              "GymTask": "safepg.envs.gym_task:GymTask"}
+                              "GymTask": "safepg.envs.gym_task:GymTask", "Pendulum": "safepg.envs.pendulum:Pendulum"}
 
 
 class UnnamedError(ValueError):

@@ -282,6 +282,25 @@ def cos(x: float) -> float:
 
 
 @njit(cache=True)
+def sincos(x: float) -> tuple[float, float]:
+    """(:func:`sin` x, :func:`cos` x), the same bits, for |x| < 1e5, without a branch.
+
+    One reduction for both, both polynomials, and the quadrant picked by selects on values
+    already computed: a loop of these vectorises (the pendulum's angles, which wind past
+    pi/4, :mod:`safepg.envs.pendulum`). Below 0.78 rad the reduction gives k = 0 and r = x
+    exactly, so this is also :func:`sin`'s and :func:`cos`'s fast path there.
+    """
+    r, q = _reduce(x)
+    s, c = sin_poly(r), cos_poly(r)
+    odd = (q & 1) == 1
+    sv = c if odd else s  # sin(r + q pi/2): s, c, -s, -c for q = 0, 1, 2, 3
+    cv = -s if odd else c  # cos(r + q pi/2): c, -s, -c, s
+    sv = -sv if (q & 2) == 2 else sv
+    cv = -cv if (q & 2) == 2 else cv
+    return sv, cv
+
+
+@njit(cache=True)
 def _sin_cos_many(x: np.ndarray, want_sin: bool) -> np.ndarray:
     out = np.empty_like(x)
     for i in range(x.size):
@@ -362,4 +381,4 @@ def log_kernel(x: float) -> float:
 
 
 __all__ = ["cholesky", "cos", "cos_array", "dot", "exp", "exp_in_range", "exp_kernel", "fsum_mean", "ipow", "log",
-           "log_kernel", "matmul", "powers", "sin", "sin_array", "solve", "trace"]
+           "log_kernel", "matmul", "powers", "sin", "sin_array", "sincos", "solve", "trace"]

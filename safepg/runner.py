@@ -259,13 +259,21 @@ def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.Pa
 class RunGroup:
     """The runs of one folder of the store: each of ``configs`` for its count of ``seeds`` (one count
     for all, or by config name), seeds ``first_seed``, ``first_seed + 1``, ...; the warm-started ones
-    from ``starts`` (by config name, one per seed in that order)."""
+    from ``starts`` (by config name, one per seed in that order).
+
+    A ``first_seed`` above 0 gives runs that share no seed with seeds 0, 1, ...: another draw of the
+    same runs, or runs a step size is chosen on that leaves those seeds unseen (:mod:`safepg.comparison`).
+    """
 
     configs: Sequence[RunConfig]
     seeds: Seeds
     folder: Path
     starts: Mapping[str, Sequence[np.ndarray]] = field(default_factory=dict)
     first_seed: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.first_seed, bool) or int(self.first_seed) != self.first_seed or self.first_seed < 0:
+            raise ValueError(f"first_seed must be an integer >= 0, got {self.first_seed!r}")
 
     def seed_range(self, config: RunConfig) -> range:
         """The seeds of ``config`` in this group."""

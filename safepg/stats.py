@@ -1,7 +1,10 @@
-"""Summaries over seeds: the mean and its 95% Student-t interval, computed the same on every CPU."""
+"""Summaries over seeds, computed the same on every CPU: the mean and its 95% Student-t interval,
+and the aggregate statistics of Agarwal et al. (2021) as their library rliable defines them (the
+interquartile mean, stratified-bootstrap percentile intervals, the probability of improvement)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from functools import cache
 from typing import Any
@@ -162,4 +165,161 @@ def t_quantile(df: int, tails: str) -> float:
         return float(mpmath.sqrt(df * (1 - lo) / lo))
 
 
-__all__ = ["mean_ci95", "prediction_band95", "prediction_interval95", "seed_summary95", "t_quantile", "t_quantile_975"]
+# ------------------------------------------------------------------ rliable's statistics
+# Agarwal, Schwarzer, Castro, Courville, Bellemare, "Deep reinforcement learning at the edge of the
+# statistical precipice", NeurIPS 2021, and their library rliable (metrics.py, library.py): with one
+# task, the scores of a method are its runs' final scores. Written here with sums in a fixed order
+# (math.fsum, or columns added one after another), so that every number is the same on every CPU.
+
+#: rliable's default number of bootstrap replications.
+BOOTSTRAP_REPS = 50_000
+
+
+def _scores(values: Iterable[float], name: str = "scores") -> np.ndarray:
+    x = np.asarray(list(values), dtype=float).ravel()
+    if x.size == 0 or not np.all(np.isfinite(x)):
+        raise ValueError(f"{name} must be one or more finite numbers, got {x.size} values")
+    return x
+
+
+def _trim(n: int) -> tuple[int, int]:
+    """The rows kept by the 25% trimmed mean of n values: [int(n / 4), n - int(n / 4)) of the sorted ones,
+    ``scipy.stats.trim_mean(x, 0.25)``'s cut."""
+    low = int(0.25 * n)
+    return low, n - low
+
+
+def interquartile_mean(values: Iterable[float]) -> float:
+    r"""The interquartile mean (IQM): the mean of the middle half of the sorted scores.
+
+    rliable's ``aggregate_iqm``, ``scipy.stats.trim_mean(scores, proportiontocut=0.25)``: of n
+    scores sorted, :math:`\lfloor n/4 \rfloor` are cut at each end and the rest averaged (exactly
+    rounded: :func:`!math.fsum`).
+    """
+    x = np.sort(_scores(values))
+    low, high = _trim(x.size)
+    return math.fsum(x[low:high].tolist()) / (high - low)
+
+
+def probability_of_improvement(x: Iterable[float], y: Iterable[float]) -> float:
+    r""":math:`P(X > Y)`, the probability that a run of X scores above a run of Y, ties counting half.
+
+    rliable's ``probability_of_improvement`` on one task: the Mann-Whitney statistic
+    :math:`U = \sum_{i,j} [x_i > y_j] + \tfrac12 [x_i = y_j]` over :math:`n_x n_y` (0.5 when the
+    two score arrays are equal).
+    """
+    a, b = _scores(x, "x"), _scores(y, "y")
+    if a.shape == b.shape and np.array_equal(a, b):
+        return 0.5
+    greater = int(np.count_nonzero(a[:, None] > b[None, :]))
+    ties = int(np.count_nonzero(a[:, None] == b[None, :]))
+    return (greater + 0.5 * ties) / (a.size * b.size)
+
+
+def _row_means(a: np.ndarray, low: int, high: int) -> np.ndarray:
+    """Mean of columns low..high-1 of each row, the columns added one after another."""
+    out = a[:, low].copy()
+    for j in range(low + 1, high):
+        out = out + a[:, j]
+    return np.asarray(out / (high - low))
+
+
+def _rng(rng: np.random.Generator | int | None) -> np.random.Generator:
+    return rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+
+
+def bootstrap_interval(values: Iterable[float], statistic: str = "mean", reps: int = BOOTSTRAP_REPS,
+                       level: float = 0.95, rng: np.random.Generator | int | None = 0,
+                       chunk: int = 5_000) -> list[float]:
+    r"""The stratified-bootstrap percentile interval of the mean or the IQM of one method's scores.
+
+    rliable's ``get_interval_estimates(..., method="percentile")`` on one task: ``reps`` resamples of
+    the n runs, drawn with replacement; the statistic of each; the interval between the
+    :math:`(1 - \text{level})/2` and :math:`(1 + \text{level})/2` quantiles of those
+    (``np.percentile``, linear interpolation, as arch's ``conf_int`` takes them).
+
+    Parameters
+    ----------
+    values
+        The runs' scores.
+    statistic : {"mean", "iqm"}
+        The mean or :func:`interquartile_mean`.
+    reps : int
+        Bootstrap replications (rliable's default 50 000).
+    level : float
+        Coverage of the interval.
+    rng : Generator, int or None
+        Seed of the resamples (rliable draws them from NumPy's global state).
+    chunk : int
+        Resamples formed at once (memory only: the numbers do not depend on it).
+
+    Returns
+    -------
+    list of float
+        ``[lower, upper]``.
+    """
+    x = _scores(values)
+    if statistic not in ("mean", "iqm"):
+        raise ValueError(f"statistic must be 'mean' or 'iqm', got {statistic!r}")
+    _check_bootstrap(reps, level)
+    gen = _rng(rng)
+    idx = gen.integers(0, x.size, size=(int(reps), x.size))
+    low, high = (0, x.size) if statistic == "mean" else _trim(x.size)
+    stats = np.concatenate([_row_means(np.sort(x[idx[i:i + chunk]], axis=1) if statistic == "iqm"
+                                       else x[idx[i:i + chunk]], low, high) for i in range(0, int(reps), chunk)])
+    return _percentile_interval(stats, level)
+
+
+def improvement_interval(x: Iterable[float], y: Iterable[float], reps: int = BOOTSTRAP_REPS, level: float = 0.95,
+                         rng: np.random.Generator | int | None = 0, chunk: int = 2_000) -> list[float]:
+    """The percentile interval of :func:`probability_of_improvement`, X and Y resampled independently
+    (rliable's ``StratifiedIndependentBootstrap``): ``[lower, upper]``."""
+    a, b = _scores(x, "x"), _scores(y, "y")
+    _check_bootstrap(reps, level)
+    gen = _rng(rng)
+    ia = gen.integers(0, a.size, size=(int(reps), a.size))
+    ib = gen.integers(0, b.size, size=(int(reps), b.size))
+    out = []
+    for i in range(0, int(reps), chunk):
+        ra, rb = a[ia[i:i + chunk]][:, :, None], b[ib[i:i + chunk]][:, None, :]
+        counts = 2 * np.count_nonzero(ra > rb, axis=(1, 2)) + np.count_nonzero(ra == rb, axis=(1, 2))
+        p = counts / (2 * a.size * b.size)
+        # rliable's 0.5 where the two resamples are the same array
+        same = np.all(a[ia[i:i + chunk]] == b[ib[i:i + chunk]], axis=1) if a.size == b.size else np.zeros(len(p), bool)
+        out.append(np.where(same, 0.5, p))
+    return _percentile_interval(np.concatenate(out), level)
+
+
+def _check_bootstrap(reps: int, level: float) -> None:
+    if isinstance(reps, bool) or int(reps) != reps or reps < 1:
+        raise ValueError(f"reps must be a positive integer, got {reps!r}")
+    if not 0 < level < 1:
+        raise ValueError(f"level must be in (0, 1), got {level!r}")
+
+
+def _percentile_interval(stats: np.ndarray, level: float) -> list[float]:
+    tail = (1.0 - level) / 2
+    lo, hi = np.percentile(stats, [100 * tail, 100 * (1.0 - tail)])
+    return [float(lo), float(hi)]
+
+
+def aggregate_scores(values: Iterable[float], reps: int = BOOTSTRAP_REPS,
+                     rng: np.random.Generator | int | None = 0) -> dict[str, Any]:
+    """The mean and the IQM of one method's scores with their 95% bootstrap intervals.
+
+    Returns
+    -------
+    dict
+        ``{"runs", "mean", "mean_ci95", "iqm", "iqm_ci95"}``; both intervals from one seed ``rng``
+        (the mean's resamples first, then the IQM's).
+    """
+    x = _scores(values)
+    gen = _rng(rng)
+    return {"runs": int(x.size), "mean": math.fsum(x.tolist()) / x.size,
+            "mean_ci95": bootstrap_interval(x, "mean", reps, rng=gen), "iqm": interquartile_mean(x),
+            "iqm_ci95": bootstrap_interval(x, "iqm", reps, rng=gen)}
+
+
+__all__ = ["BOOTSTRAP_REPS", "aggregate_scores", "bootstrap_interval", "improvement_interval", "interquartile_mean",
+           "mean_ci95", "prediction_band95", "prediction_interval95", "probability_of_improvement", "seed_summary95",
+           "t_quantile", "t_quantile_975"]

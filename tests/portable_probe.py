@@ -15,8 +15,10 @@ import numpy as np
 
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
+from safepg.envs.pendulum import Pendulum
 from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
-from safepg.options import ErrorModel, FixedStep, Gradient, SafeStep
+from safepg.options import Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep
+from safepg.policies import LinearGaussianPolicy
 from safepg.stats import mean_ci95
 
 
@@ -48,6 +50,14 @@ def runs() -> dict[str, list[LearningRecord]]:
                                         budget=2_000, rng=0)],
         "cartpole-adaptive": [adaptive_pg(CartPole.thesis_doubled(), np.array([0.5, 1.0, 20.0, 3.0]),
                                           error=bernstein_er, budget=2_000, rng=0)],
+        # The pendulum's kernel: its sines past pi/4, the reward's remainder, both estimators.
+        "pendulum-adaptive": [adaptive_pg(Pendulum(), np.zeros(3), gradient=Gradient(score_action="raw"),
+                                          error=bernstein_er, batches=Batches(n_min=10, first=600),
+                                          departures=Departures(batch_constants=True, maxima=True,
+                                                                unguarded_step=True), budget=3_000, rng=s)
+                              for s in range(2)],
+        "pendulum-vanilla": [vanilla_pg(Pendulum(), np.array([0.0, 0.0, 1.0]), batch_size=700,
+                                        step=FixedStep(1e-5), gradient=Gradient("reinforce"), budget=1_400, rng=0)],
     }
 
 
@@ -73,6 +83,8 @@ def main() -> None:
         out[name] = [digest(r) for r in recs]
         ci = mean_ci95(r.upsilon_bar() for r in recs)
         out[name + ":ci95"] = [float.hex(v) for v in ci["ci95"]] if len(recs) > 1 else None
+    returns = Pendulum().episode_returns(LinearGaussianPolicy(np.array([[-1.0, -6.0, -1.5]]), 0.5), 700, 3)
+    out["pendulum-returns"] = [hashlib.sha256(np.ascontiguousarray(r).tobytes()).hexdigest() for r in returns]
     lqg2 = LQG.thesis_2d(gamma=0.9)
     out["closed-forms"] = [float.hex(float(v)) for v in (
         *lqg2.optimal_gain().ravel(), lqg2.performance(np.diag([-0.3, -0.5]), 1.0),

@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
+from safepg import safety
 from safepg.envs.lqg import LQG
 from safepg.learning import vanilla_pg
 from safepg.options import ErrorModel, FixedStep
-from safepg.thesis import audit, safety
+from safepg.thesis import audit
 from safepg.thesis import experiments as ex
 
 

@@ -14,7 +14,8 @@ import pytest  # noqa: E402
 import sympy as sp  # noqa: E402
 from script_module import load
 
-from safepg.thesis.analysis import errata_markdown, markdown_table, with_labels  # noqa: E402
+from safepg.tables import markdown_table  # noqa: E402
+from safepg.thesis.analysis import errata_markdown, with_labels  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

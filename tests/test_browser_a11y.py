@@ -8,7 +8,7 @@ there), which loads each page once for all its page-wide checks; this module hol
 Any violation of impact "serious" or "critical" fails the test, printed as page, theme,
 rule id, impact, the target selectors and axe's one-line help. The checker itself is
 checked: on a probe page an unlabelled slider, checkbox and select must be reported, while
-the same controls in an :class:`~safepg.thesis.explorers.component.Explorer` (labelled by
+the same controls in an :class:`~safepg.explorers.component.Explorer` (labelled by
 its markup, or named by its script when a control comes without a label) must not.
 
 Every explorer control on the built pages has an accessible name, is reached with Tab, and

@@ -49,8 +49,8 @@ def run_js(expr_cases: list[str]) -> list:
 
 
 def test_static_sources_parse(tmp_path):
-    static = resources.files("safepg.thesis.explorers").joinpath("static")
-    names = sorted(f.name for f in static.iterdir() if f.name.endswith(".js"))
+    names = sorted(f.name for package in ("safepg.explorers", "safepg.thesis.explorers")
+                   for f in resources.files(package).joinpath("static").iterdir() if f.name.endswith(".js"))
     assert {"lib.js", "runtime.js", "lqg_compute.js", "upsilon_compute.js", "live_page.js", "learner.js"} <= set(names)
     for name in names:
         src = static_text(name)

@@ -12,7 +12,7 @@ import subprocess
 import pytest
 
 from conftest import require_node
-from safepg.thesis.explorers.component import static_text
+from safepg.explorers.component import static_text
 
 pytestmark = pytest.mark.node  # Node.js runs the JavaScript (tests/conftest.py: skipped or failed without it)
 

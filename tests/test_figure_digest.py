@@ -1,4 +1,4 @@
-"""Figures under nbval: a figure's text form is the digest of what it plots (safepg/thesis/figure_digest.py).
+"""Figures under nbval: a figure's text form is the digest of what it plots (safepg/figure_digest.py).
 
 nbval skips images and the sanitizer reduces a figure's text to ``<Figure>``, so a figure cell passes
 whatever it draws. With ``plotting.use_style(digest=True)`` the text form of every figure is its
@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from safepg.thesis.figure_digest import figure_digest  # noqa: E402
+from safepg.figure_digest import figure_digest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SANITIZER = ROOT / "tests" / "nbval_sanitize.cfg"

@@ -1,4 +1,4 @@
-"""The explorers' kernel-backed view (safepg/thesis/explorers/kernel_view.py), without a browser.
+"""The explorers' kernel-backed view (safepg/explorers/kernel_view.py), without a browser.
 
 Every control of every book explorer redraws the figure; a move supersedes the running
 computation instead of queueing behind it; an error is one line in the view, never a
@@ -16,7 +16,7 @@ from conftest import import_or_fail
 
 import_or_fail("ipywidgets")
 
-from safepg.thesis.explorers.component import Explorer, Plot, Select, Slider  # noqa: E402
+from safepg.explorers.component import Explorer, Plot, Select, Slider  # noqa: E402
 from safepg.thesis.explorers.curves import lqg_explorer, upsilon_explorer  # noqa: E402
 from safepg.thesis.explorers.live_learner import live_batch_size_explorer  # noqa: E402
 

@@ -61,7 +61,7 @@ def test_figure_draws_those_curves():
 
 
 def test_safety_figure_draws_each_change_and_interval():
-    from safepg.thesis.safety import MonteCarloOutcomes
+    from safepg.safety import MonteCarloOutcomes
 
     def outcomes(change, half):
         c = np.asarray(change, dtype=float)

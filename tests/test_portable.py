@@ -316,7 +316,8 @@ def test_runs_are_bit_identical_across_cpu_settings(tmp_path: Path) -> None:
              _probe({"NUMBA_CPU_NAME": "generic", "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX",
                      "NPY_DISABLE_CPU_FEATURES": "X86_V3"}, tmp_path / "old")]
     host, generic, old_cpu = (_result(p) for p in procs)
-    assert set(host) >= {"1d-bernstein-er", "2d-scalar-step", "cartpole-adaptive", "closed-forms", "significance"}
+    assert set(host) >= {"1d-bernstein-er", "2d-scalar-step", "cartpole-adaptive", "pendulum-adaptive",
+                         "pendulum-vanilla", "pendulum-returns", "closed-forms", "significance"}
     for name in host:
         assert generic[name] == host[name], f"{name} differs with NUMBA_CPU_NAME=generic"
         assert old_cpu[name] == host[name], f"{name} differs with a pre-AVX2 libm and NumPy"

@@ -10,9 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from safepg import safety_store
 from safepg.cli import main
 from safepg.envs.lqg import LQG
-from safepg.thesis import prefetch, safety_store, table51_sweep
+from safepg.thesis import prefetch, table51_sweep
 from safepg.thesis.budget import CHAPTER_EXPERIMENTS, compile_seconds
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiments import EXPERIMENTS, get_experiment

@@ -6,10 +6,11 @@ import json
 import numpy as np
 import pytest
 
+from safepg import safety, safety_store
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
+from safepg.envs.pendulum import Pendulum
 from safepg.policies import LinearGaussianPolicy
-from safepg.thesis import safety, safety_store
 
 # The unclipped 1-D LQG over a long horizon: its simulated J is the closed form up to 0.9^150 ~ 1e-7.
 ENV = LQG.thesis_1d(clip=False, horizon=150)
@@ -74,6 +75,21 @@ def test_discounted_cart_pole_returns_come_from_the_episode_lengths():
         sim = env.simulate(LinearGaussianPolicy(th[None, :], 1.0), 300, 5)
         np.testing.assert_allclose(got, sim.discounted_returns(), rtol=0, atol=1e-11)
     assert env.gamma == 0.99 and a.max() <= (1 - 0.99 ** env.horizon) / 0.01 + 1e-9
+
+
+def test_pendulum_pairs_use_the_kernel_with_common_random_numbers():
+    """The pendulum's paired rollouts come from its fused kernel: the discounted returns of
+    ``simulate``'s batch for each policy, the same starts and normals for both."""
+    env = Pendulum()
+    theta = np.array([-1.0, -3.0, 0.5])
+    other = theta + [0.0, 0.05, 0.0]
+    a, b = safety.paired_returns(env, theta, other, 1.0, 400, 5)
+    for th, got in ((theta, a), (other, b)):
+        sim = env.simulate(LinearGaussianPolicy(th[None, :], 1.0), 400, 5)
+        np.testing.assert_allclose(got, sim.discounted_returns(), rtol=1e-12)
+    assert np.std(b - a) < 0.3 * np.std(a)  # the pairs share their randomness
+    out = safety.monte_carlo_changes(env, np.array([theta, other]), 1.0, looks=(300,), seed=2)
+    assert out.steps == 2 * 300 * env.horizon
 
 
 def test_steps_lived_are_counted(outcomes):

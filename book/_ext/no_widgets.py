@@ -1,7 +1,7 @@
 """Fail the build when a page carries a Jupyter widget output.
 
 The book loads no widget manager (``nb_ipywidgets_js: {}`` in ``_config.yml``): its
-interactive figures are plain HTML and JavaScript (``safepg.thesis.explorers.component``), which need no
+interactive figures are plain HTML and JavaScript (``safepg.explorers.component``), which need no
 kernel, no require.js and no CDN. A widget output (for example ``Explorer.interactive()``
 left in a chapter) would render as nothing in the static page, silently; this turns that
 into a build warning, an error under ``jupyter-book build -W``.
@@ -21,7 +21,7 @@ def _check(app: Any, pagename: str, templatename: str, context: dict, doctree: A
     if WIDGET_MIME in context.get("body", ""):
         logger.warning(
             "a Jupyter widget output cannot render in the static book (no widget manager is "
-            "loaded); display a safepg.thesis.explorers.component.Explorer instead of .interactive() or ipywidgets",
+            "loaded); display a safepg.explorers.component.Explorer instead of .interactive() or ipywidgets",
             type="safepg", subtype="widget", location=pagename)
 
 

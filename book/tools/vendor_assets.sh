@@ -14,7 +14,7 @@
 # holds for axe-core (axe.min.js, about 0.55 MB, MPL-2.0), which only the tests load: it
 # goes under _build/, outside html_static_path, so it is never published with the book.
 # Why MathJax only in the book: the explorers are plain text/html with inline JavaScript (see
-# safepg/thesis/explorers/component.py), so the pages need neither require.js nor the ipywidgets HTML
+# safepg/explorers/component.py), so the pages need neither require.js nor the ipywidgets HTML
 # manager; book/_ext/no_widgets.py fails the build if a widget output ever appears.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"

@@ -20,7 +20,7 @@ from dataclasses import dataclass, fields
 from functools import cache
 from pathlib import Path
 
-from safepg.thesis.analysis import Table, markdown_table
+from safepg.tables import Table, markdown_table
 from safepg.thesis.authors import REPOSITORY
 
 #: Folder of the audit tables.

@@ -24,7 +24,7 @@ from safepg.runner import RESULTS_VERSION, TIMING_FILE
 from safepg.thesis.cartpole_sweep import baseline_experiments
 from safepg.thesis.experiment_store import experiment_folder, load_experiment
 from safepg.thesis.experiments import get_experiment
-from safepg.thesis.prefetch import COMPILE_ONCE
+from safepg.thesis.prefetch import COMPARISON, COMPILE_ONCE
 
 #: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
 CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
@@ -136,6 +136,37 @@ def safety_work(root: Path) -> list[Work]:
     return out
 
 
+def comparison_work(root: Path) -> Work | None:
+    """The pendulum chapter's comparison (:func:`safepg.comparison.run_comparison`): its runs (the step
+    search's and the methods'), every trajectory H = 200 steps of one normal and two uniforms, and its
+    safety measurements (their steps from the stored outcomes), with the recorded seconds of all three."""
+    from safepg.record import LearningRecord, RecordFileError
+
+    folder = root / COMPARISON
+    if not folder.is_dir():
+        return None
+    traj = steps = uniforms = 0
+    for path in sorted(folder.rglob("seed-*.npz")):
+        try:
+            rec = LearningRecord.load(path)
+        except (OSError, RecordFileError):  # a damaged file: its run is counted when computed again
+            continue
+        n = int(rec.batch_size.sum())
+        traj += n
+        steps += n * int(rec.config["task"]["horizon"])
+        uniforms += 2 * n
+    seconds = [_timing_seconds(folder), _timing_seconds(folder / "search")]
+    for p in sorted((folder / "safety-mc").glob("*.json")):
+        d = json.loads(p.read_text())
+        rollouts = 2 * sum(d["outcomes"]["rollouts"])
+        traj += rollouts
+        steps += d["outcomes"].get("steps", 0)
+        uniforms += 2 * rollouts
+        seconds.append(d.get("seconds"))
+    known = [x for x in seconds if x is not None]
+    return Work(COMPARISON, "pendulum", traj, steps, steps, uniforms, sum(known) if known else None)
+
+
 def compile_seconds(root: Path) -> float | None:
     """The seconds ``run-book`` spent compiling the kernels once before its tasks
     (:func:`safepg.runner.compile_once`; in no experiment's time), or None if it did not."""
@@ -146,7 +177,8 @@ def campaign(root: Path) -> list[Work]:
     """Every stored computation of the book's campaign, chapter by chapter."""
     out = [experiment_work(n, ch, root) for ch, names in CHAPTER_EXPERIMENTS.items() for n in names]
     sweep = sweep_work(root)
-    return out + ([sweep] if sweep else []) + safety_work(root)
+    pendulum = comparison_work(root)
+    return out + ([sweep] if sweep else []) + safety_work(root) + ([pendulum] if pendulum else [])
 
 
 def budget_rows(works: list[Work], normal_rate: float, uniform_rate: float,

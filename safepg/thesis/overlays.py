@@ -512,10 +512,10 @@ def figure_cartpole_overlay(records: Mapping[str, Sequence[LearningRecord]], lab
 
 
 def figure_cartpole_safety(measured: Mapping[str, Any]) -> Figure:
-    """Each measured update's change of J with its interval (:func:`safepg.thesis.safety_store.measure_runs`).
+    """Each measured update's change of J with its interval (:func:`safepg.safety_store.measure_runs`).
 
-    ``measured`` maps a label to a :class:`~safepg.thesis.safety.MonteCarloOutcomes` (one run, or
-    several joined by :meth:`~safepg.thesis.safety.MonteCarloOutcomes.join`); labels with
+    ``measured`` maps a label to a :class:`~safepg.safety.MonteCarloOutcomes` (one run, or
+    several joined by :meth:`~safepg.safety.MonteCarloOutcomes.join`); labels with
     "adaptive" go to the left panel, the others (the fixed-step runs) to the right one, each on
     its own scale. Within a panel the labels follow each other, updates in their order; labels
     without updates are left out.

@@ -10,6 +10,9 @@ r"""What the book's chapters compute, computed before ``jupyter-book build``, wi
   ``cartpole-sweep``;
 - ``sweep_paths(...)``: the Table 5.1 sweep (its literal keyword arguments kept);
 - ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`);
+- ``run_comparison(pendulum_comparison(...))``: the pendulum chapter's comparison
+  (:func:`safepg.comparison.run_comparison`: its step search, its runs and their safety
+  measurements), with the literal keyword arguments of ``pendulum_comparison``;
 - ``false_alarms_stored(...)``: the scorecard's false-alarm checks of its rules;
 
 and after the experiments, the scorecard's seed rule (:mod:`safepg.thesis.seed_rule`): the seeds its
@@ -23,7 +26,7 @@ reported as stored in one line.
 
 Progress: on a terminal, one tqdm bar per task (runs done / total, trajectories, elapsed time
 and time left), redrawn every second; otherwise (CI, a log) plain lines: one when a task
-starts, one when it ends, and at most one progress line every :data:`PLAIN_INTERVAL` seconds.
+starts, one when it ends, and at most one progress line every :data:`safepg.thesis.progress.PLAIN_INTERVAL` seconds.
 """
 
 from __future__ import annotations
@@ -33,32 +36,28 @@ import json
 import os
 import re
 import sys
-import threading
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO, cast
 
 import numpy as np
-from tqdm import tqdm
 
 from safepg import runner
 from safepg.learning import LearningRecord
 from safepg.runner import RunConfig
 from safepg.thesis.experiment_store import experiment_folder, read_campaign, run_experiment, run_experiments
 from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment, scaled
+from safepg.thesis.progress import PREFIX, Progress, duration, previous_seconds
+from safepg.thesis.progress import reporting_stored_runs as _reporting_stored_runs
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
 BOOK = Path(__file__).resolve().parents[2] / "book"
-#: Seconds between two progress lines when the output is not a terminal.
-PLAIN_INTERVAL = 30.0
-#: Seconds between two redraws of a terminal's bar (its elapsed time and time left move).
-TTY_INTERVAL = 1.0
-PREFIX = "run-book"
 #: The store's folder of the time :func:`safepg.runner.compile_once` took (its ``timing.jsonl``).
 COMPILE_ONCE = "compile-once"
+#: The name of the pendulum chapter's comparison task (and its folder of the store).
+COMPARISON = "pendulum"
 
 
 @dataclass(frozen=True)
@@ -66,8 +65,9 @@ class Task:
     """One stored computation a chapter needs.
 
     ``kind`` is ``"experiment"`` (``name`` in the registry, run for ``seeds`` seeds),
-    ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``) or
-    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements) or ``"false-alarms"`` (the
+    ``"table-5.1-sweep"`` (``options``: the keyword arguments of ``sweep_paths``),
+    ``"safety-mc"`` (the cart-pole chapter's Monte Carlo measurements), ``"comparison"`` (``options``:
+    the keyword arguments of :func:`safepg.comparison.pendulum_comparison`) or ``"false-alarms"`` (the
     scorecard's measured false alarms).
     """
 
@@ -154,6 +154,9 @@ def chapter_requests(notebook: Path) -> list[Task]:
                 tasks.append(Task(chapter, "safety-mc", "safety-mc"))
             elif name == "false_alarms_stored":
                 tasks.append(Task(chapter, "false-alarms", "false-alarms"))
+            elif name == "pendulum_comparison":
+                tasks.append(Task(chapter, COMPARISON, "comparison",
+                                  options=_literal_keywords(call, ("seeds", "budget", "episodes"))))
     return tasks
 
 
@@ -181,164 +184,6 @@ def book_tasks(book: Path = BOOK) -> list[Task]:
         for t in chapter_requests(nb):
             add(t)
     return out
-
-
-# ------------------------------------------------------------------ progress
-def _duration(seconds: float | None) -> str:
-    if seconds is None or not np.isfinite(seconds):
-        return "?"
-    s = int(round(seconds))
-    return f"{s // 3600}h{s % 3600 // 60:02d}m" if s >= 3600 else f"{s // 60}m{s % 60:02d}s" if s >= 60 else f"{s}s"
-
-
-class _Bar(tqdm):  # type: ignore[misc]  # tqdm ships no types (an Any base to mypy), and subclassing is the API
-    """A tqdm bar with one more field for its format, ``{status}``."""
-
-    def __init__(self, *args: Any, status: str = "", **kwargs: Any) -> None:
-        self.status = status
-        super().__init__(*args, **kwargs)
-
-    @property
-    def format_dict(self) -> dict[str, Any]:
-        return {**super().format_dict, "status": self.status}
-
-
-class Progress:
-    """Progress of one task: ``total`` units (runs, or measured runs) of which ``done`` were stored.
-
-    The time left is the elapsed time times the work left over the work done since the start,
-    the work of a run being its trajectory budget (an early-stopping run counts as its budget);
-    before the first unit, the time the last build recorded (``benchmarks/book_timings.json``)
-    scaled to the work left, if known. ``tty`` draws a tqdm bar; otherwise plain lines, a
-    progress line at most every ``interval`` seconds.
-    """
-
-    def __init__(self, name: str, total: int, done: int, work_left: float, unit: str = "runs",
-                 stream: TextIO | None = None, tty: bool | None = None, interval: float | None = None,
-                 previous_s: float | None = None, clock: Callable[[], float] = time.monotonic,
-                 ticker: bool = True) -> None:
-        self.name, self.total, self.done, self.unit = name, total, done, unit
-        self.stream = stream or sys.stdout
-        self.tty = self.stream.isatty() if tty is None else tty
-        self.interval = interval if interval is not None else TTY_INTERVAL if self.tty else PLAIN_INTERVAL
-        self.work_left, self.work_done, self.previous_s = float(work_left), 0.0, previous_s
-        self.trajectories = 0
-        self.clock = clock
-        self.started = self.last_line = clock()
-        self.lock = threading.Lock()
-        self.bar = None
-        if self.tty:
-            import shutil
-
-            # A terminal that does not say its width (0 columns) gets 100, not an empty bar.
-            width = shutil.get_terminal_size((100, 24)).columns
-            self.bar = _Bar(total=total, initial=done, desc=f"{PREFIX}: {name}", file=self.stream,
-                            bar_format="{desc}: {n_fmt}/{total_fmt} " + unit + " |{bar}| {status}",
-                            ncols=width if width > 0 else 100, status=self._status())
-        else:
-            self._print(f"{name}: computing {total - done} of {total} {unit} ({done} stored)"
-                        + (f", last build took {_duration(previous_s)}" if previous_s else ""))
-        self._stop = threading.Event()
-        self._thread = None
-        if ticker:
-            self._thread = threading.Thread(target=self._tick, daemon=True)
-            self._thread.start()
-
-    def _print(self, text: str) -> None:
-        print(f"{PREFIX}: {text}", file=self.stream, flush=True)
-
-    def elapsed(self) -> float:
-        return self.clock() - self.started
-
-    def left(self) -> float | None:
-        if self.work_done > 0:
-            return self.elapsed() * self.work_left / self.work_done
-        if self.previous_s is not None:
-            return max(self.previous_s - self.elapsed(), 0.0)
-        return None
-
-    def _status(self) -> str:
-        left = self.left()
-        return (f"{self.trajectories:.3g} trajectories, {_duration(self.elapsed())} elapsed, "
-                + ("time left unknown yet" if left is None else f"about {_duration(left)} left"))
-
-    def _line(self) -> None:
-        self.last_line = self.clock()
-        self._print(f"{self.name}: {self.done}/{self.total} {self.unit}, {self._status()}")
-
-    def _tick(self) -> None:
-        while not self._stop.wait(min(self.interval, 1.0)):
-            self.tick()
-
-    def tick(self) -> None:
-        """Redraw the bar, or print a progress line if ``interval`` has passed since the last."""
-        with self.lock:
-            if self.bar is not None:
-                self.bar.status = self._status()
-                self.bar.refresh()
-            elif self.clock() - self.last_line >= self.interval:
-                self._line()
-
-    def advance(self, trajectories: int, work: float, units: int = 1) -> None:
-        """``units`` more done, which simulated ``trajectories`` and were ``work`` of the work left."""
-        with self.lock:
-            self.done += units
-            self.trajectories += int(trajectories)
-            self.work_done += work
-            self.work_left = max(self.work_left - work, 0.0)
-            if self.bar is not None:
-                self.bar.status = self._status()
-                self.bar.update(units)
-            elif self.clock() - self.last_line >= self.interval and self.done < self.total:
-                self._line()
-
-    def note(self, text: str) -> None:
-        """One line about the task (above the bar on a terminal)."""
-        with self.lock:
-            if self.bar is not None:
-                self.bar.write(f"{PREFIX}: {text}", file=self.stream)
-            else:
-                self._print(text)
-
-    def close(self, finished: bool = True) -> None:
-        """Stop the redraws and say how it ended: ``done``, or ``stopped`` (an error, Ctrl-C)."""
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-        with self.lock:
-            if self.bar is not None:
-                self.bar.status = f"{self.trajectories:.3g} trajectories, {_duration(self.elapsed())}"
-                self.bar.close()
-            self._print(f"{self.name}: {'done' if finished else 'stopped'}, {self.done}/{self.total} {self.unit}, "
-                        f"{self.trajectories:.3g} trajectories in {_duration(self.elapsed())}")
-
-
-def previous_seconds(book: Path, name: str) -> float | None:
-    """The seconds the last measured build took for ``name`` (``benchmarks/book_timings.json``)."""
-    try:
-        t = json.loads((book.parent / "benchmarks" / "book_timings.json").read_text())
-        return next(float(e["seconds"]) for e in t["experiments"] if e["name"] == name)
-    except (OSError, ValueError, KeyError, TypeError, StopIteration):
-        return None
-
-
-@contextmanager
-def _reporting_stored_runs(progress: Progress,
-                           counted: Callable[[LearningRecord, Path], bool] | None = None) -> Iterator[None]:
-    """Tell ``progress`` of every run the runner stores (``run_configs`` stores each as it arrives),
-    or of those for which ``counted(record, folder)`` is true."""
-    store = runner.store_run
-
-    def store_and_report(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
-        store(rec, folder, cfg, seed)
-        if counted is None or counted(rec, Path(folder)):
-            progress.advance(int(np.sum(rec.batch_size)), float(cfg.budget))
-
-    runner.store_run = store_and_report
-    try:
-        yield
-    finally:
-        runner.store_run = store
 
 
 # ------------------------------------------------------------------ the tasks
@@ -442,7 +287,7 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
         trajectories[folder] += int(np.sum(rec.batch_size))
         if left[folder] == 0:
             progress.note(f"{names[folder]}: done, {runs[folder]}/{runs[folder]} runs, "
-                          f"{trajectories[folder]:.3g} trajectories, at {_duration(progress.elapsed())}")
+                          f"{trajectories[folder]:.3g} trajectories, at {duration(progress.elapsed())}")
         return True
 
     try:
@@ -505,7 +350,7 @@ def safety_plan(root: Path) -> list[tuple[str, Any, np.ndarray, tuple[int, ...]]
 def prefetch_safety(task: Task, root: Path, stream: TextIO | None = None, tty: bool | None = None,
                     interval: float | None = None, book: Path = BOOK) -> str:
     """The cart-pole chapter's safety measurements, run by run, with the chapter's processes per run."""
-    from safepg.thesis.safety_store import is_measured, measure_runs
+    from safepg.safety_store import is_measured, measure_runs
 
     stream = stream or sys.stdout
     folder = root / "safety-mc"
@@ -550,12 +395,43 @@ def prefetch_false_alarms(task: Task, root: Path, jobs: int = -1, stream: TextIO
     return "computed"
 
 
+def _comparison(task: Task) -> Any:
+    from safepg.comparison import pendulum_comparison
+
+    return pendulum_comparison(**dict(task.options))
+
+
+def prefetch_comparison(task: Task, root: Path, jobs: int = -1, stream: TextIO | None = None,
+                        tty: bool | None = None, interval: float | None = None, book: Path = BOOK) -> str:
+    """The pendulum chapter's comparison (:func:`safepg.comparison.run_comparison`): its step search,
+    runs and safety measurements, a line as each ends; ``"stored"`` or ``"computed"``."""
+    from safepg.comparison import is_computed, run_comparison
+
+    stream, cmp = stream or sys.stdout, _comparison(task)
+    if is_computed(cmp, root):
+        _say(stream, f"{task.name}: stored (its comparison: the step search, the runs, their safety)")
+        return "stored"
+    started = time.monotonic()
+    _say(stream, f"{task.name}: computing its step search, its runs and their safety measurements")
+    run_comparison(cmp, root, jobs, report=lambda line: _say(stream, f"{task.name}: {line}"))
+    _say(stream, f"{task.name}: done in {duration(time.monotonic() - started)}")
+    return "computed"
+
+
 def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
-    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute."""
+    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute
+    (and of the pendulum's comparison, if it has)."""
     from joblib import effective_n_jobs
+
+    from safepg.comparison import is_computed
 
     configs = []
     for t in tasks:
+        if t.kind == "comparison":
+            cmp = _comparison(t)
+            if not is_computed(cmp, root):
+                configs += [*cmp.adaptive, *cmp.search_configs()]
+            continue
         if t.kind == "experiment":
             exp = scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget)
             folder = experiment_folder(exp, root)
@@ -570,7 +446,7 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
         (root / COMPILE_ONCE).mkdir(parents=True, exist_ok=True)
         # benchmarks/bench_book.py reads it
         runner.record_timing(root / COMPILE_ONCE, seconds, runs, effective_n_jobs(jobs))
-        _say(stream, f"kernels compiled once, each task family in one worker, in {_duration(seconds)}")
+        _say(stream, f"kernels compiled once, each task family in one worker, in {duration(seconds)}")
 
 
 def _scorecard_tasks(tasks: list[Task]) -> bool:
@@ -597,7 +473,7 @@ def _apply_seed_rule(root: Path, jobs: int, book: Path, kw: dict[str, Any]) -> N
     campaign = plan_seeds(root, lambda folder: build_rows(folder, book), jobs, run=run,
                           stream=cast(TextIO, _Prefixed(stream)))
     _say(stream, f"seed rule: {len(campaign.seeds)} configurations beyond their experiment's seeds, in "
-                 f"{_duration(time.monotonic() - started)}")
+                 f"{duration(time.monotonic() - started)}")
 
 
 class _Prefixed:
@@ -640,9 +516,11 @@ def prefetch(book: Path = BOOK, root: Path | None = None, jobs: int = -1, stream
             done[t.name] = prefetch_sweep(t, root, **kw)
         elif t.kind == "false-alarms":
             done[t.name] = prefetch_false_alarms(t, root, jobs, **kw)
+        elif t.kind == "comparison":
+            done[t.name] = prefetch_comparison(t, root, jobs=jobs, **kw)
         else:
             done[t.name] = prefetch_safety(t, root, **kw)
     computed = sum(v == "computed" for v in done.values())
     _say(stream, f"{computed} computed, {len(done) - computed} already stored, in "
-                 f"{_duration(time.monotonic() - started)}")
+                 f"{duration(time.monotonic() - started)}")
     return done

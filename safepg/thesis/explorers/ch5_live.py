@@ -170,7 +170,7 @@ def kernel_text(res: dict[str, Any]) -> dict[str, Any]:
 
 
 class Ch5LiveExplorer(Explorer):
-    """An :class:`~safepg.thesis.explorers.component.Explorer` whose page runs the JavaScript
+    """An :class:`~safepg.explorers.component.Explorer` whose page runs the JavaScript
     learner in a Web Worker (see the module docstring); ``compute_js`` names the page script,
     ``presets`` are one-click buttons setting several controls (name -> (label, values)), and
     ``links`` controls that set others when they take a value (name -> ((value, {other: value}), ...)),

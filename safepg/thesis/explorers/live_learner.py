@@ -1,6 +1,6 @@
 r"""The live batch-size explorer: Algorithm 4.1 reruns in the reader's browser.
 
-:func:`live_batch_size_explorer` returns an :class:`~safepg.thesis.explorers.component.Explorer` whose page
+:func:`live_batch_size_explorer` returns an :class:`~safepg.explorers.component.Explorer` whose page
 half (``static/live_page.js``, with the component's ``static/runtime.js``) runs the JavaScript
 learner ``safepg/thesis/explorers/static/learner.js`` (Algorithm 4.1 and vanilla
 policy gradient on ``LQG.thesis_1d()``, the same algorithm as :mod:`safepg.learning`) in
@@ -141,7 +141,7 @@ def overlay_key(p: Mapping[str, Any]) -> str:
 
 
 class LiveLearnerExplorer(Explorer):
-    """An :class:`~safepg.thesis.explorers.component.Explorer` whose page runs the JavaScript learner in a
+    """An :class:`~safepg.explorers.component.Explorer` whose page runs the JavaScript learner in a
     Web Worker (see the module docstring); ``compute_js`` is unused."""
 
     continuous_update = False  # interactive(): each change is a whole learning run, so sliders act on release

@@ -52,7 +52,7 @@ def render_png(explorer: Any, res: dict[str, Any], dpi: int = 100) -> bytes:
 
     Parameters
     ----------
-    explorer : safepg.thesis.explorers.component.Explorer
+    explorer : safepg.explorers.component.Explorer
         Gives the plots (axis labels, scales, limits) and the panel width.
     res : dict
         ``compute_py``'s result: ``{"plots": {plot_id: {"series": [...], "markers": [...]}}}``.
@@ -131,7 +131,7 @@ class ExplorerView(w.VBox):  # type: ignore[misc]  # ipywidgets ships no types: 
 
     Parameters
     ----------
-    explorer : safepg.thesis.explorers.component.Explorer
+    explorer : safepg.explorers.component.Explorer
         Not imported here: the component imports this module when asked for a view. Its
         controls become ipywidgets (sliders act while they move when the explorer's
         ``continuous_update`` is True, on release otherwise); its ``compute_py`` is called
