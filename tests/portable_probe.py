@@ -63,13 +63,14 @@ def runs() -> dict[str, list[LearningRecord]]:
 
 def significance() -> dict[str, object]:
     """The scorecard's tests on fixed numbers: every p-value, detectable difference and correction bit."""
+    from safepg import curve_tests as ct
     from safepg import significance as sg
 
     rng = np.random.default_rng(11)
     ours, theirs = rng.normal(size=(10, 3)), rng.normal(0.4, 1.0, size=(5, 3))
     tests = [sg.PredictionTest((0.1, 0.12), tuple(ours[:, 0]), resolution=0.01),
              sg.WelchTest(0.3, (0.1, 0.5), 5, tuple(ours[:, 1]), 5e-5, 0.9),
-             sg.CurvePredictionTest(theirs[0], ours), sg.PermutationTest(theirs, ours)]
+             ct.CurvePredictionTest(theirs[0], ours), ct.PermutationTest(theirs, ours)]
     rejected, level = sg.benjamini_hochberg([t.p_value for t in tests], 0.05)
     return {"p": [float.hex(t.p_value) for t in tests],
             "detectable": [float.hex(t.detectable_difference(0.01)) for t in tests],

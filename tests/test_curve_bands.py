@@ -201,7 +201,7 @@ def test_figures_51_52_under_the_authors_processing() -> None:
 def test_hypotheses_and_spread_of_figures_51_52() -> None:
     """Our "seeds" are their runs 2-5; their run 1, held out, is scored under their processing against the
     band of those four, recomputed here from scipy's t quantile (an independent band)."""
-    from safepg.thesis.curve_bands import FIGURES_51_52_HYPOTHESES, figures51_52_hypotheses, figures51_52_spread
+    from safepg.thesis.curve_spread import FIGURES_51_52_HYPOTHESES, figures51_52_hypotheses, figures51_52_spread
 
     key, name = ("gpomdp", "chebyshev", False, 0.75), "gpomdp-chebyshev-delta=0.75"
     runs = authors.table52_runs()[key]
@@ -228,7 +228,7 @@ def test_curve_test_two_samples_and_one_run() -> None:
     """The curve's test takes block means over the range every curve covers: their five runs against ours by
     the permutation test, one run by Hotelling's test; a shift of theirs by many standard deviations is found
     (the smallest p of 5 against 10), the same process is not."""
-    from safepg.significance import CurvePredictionTest, PermutationTest
+    from safepg.curve_tests import CurvePredictionTest, PermutationTest
     from safepg.thesis.curve_bands import curve_test
 
     rng = np.random.default_rng(3)

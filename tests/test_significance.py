@@ -10,34 +10,36 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from safepg import curve_tests as ct
+from safepg import distributions as dist
 from safepg import significance as sg
 
 
 @pytest.mark.parametrize("t, df", [(0.0, 3), (1.3, 4), (2.776, 4), (4.0, 9), (10.0, 2.5), (3.0, 200)])
 def test_t_p_value_is_scipy_s(t: float, df: float) -> None:
-    assert sg.t_two_sided_p(t, df) == pytest.approx(2 * stats.t.sf(abs(t), df), rel=1e-12, abs=1e-300)
+    assert dist.t_two_sided_p(t, df) == pytest.approx(2 * stats.t.sf(abs(t), df), rel=1e-12, abs=1e-300)
 
 
 @pytest.mark.parametrize("f, d1, d2", [(0.5, 3, 7), (3.0, 3, 7), (9.0, 1, 4), (2.0, 2, 30)])
 def test_f_p_value_is_scipy_s(f: float, d1: float, d2: float) -> None:
-    assert sg.f_upper_p(f, d1, d2) == pytest.approx(stats.f.sf(f, d1, d2), rel=1e-12)
+    assert dist.f_upper_p(f, d1, d2) == pytest.approx(stats.f.sf(f, d1, d2), rel=1e-12)
 
 
 @pytest.mark.parametrize("df, alpha", [(4, 0.05), (9, 0.01), (2.5, 0.2), (30, 0.0005)])
 def test_t_critical_is_scipy_s(df: float, alpha: float) -> None:
-    assert sg.t_critical(df, alpha) == pytest.approx(stats.t.ppf(1 - alpha / 2, df), rel=1e-10)
+    assert dist.t_critical(df, alpha) == pytest.approx(stats.t.ppf(1 - alpha / 2, df), rel=1e-10)
 
 
 @pytest.mark.parametrize("d1, d2, alpha", [(3, 7, 0.05), (1, 4, 0.01), (2, math.inf, 0.01)])
 def test_f_critical_is_scipy_s(d1: float, d2: float, alpha: float) -> None:
     expected = stats.chi2.ppf(1 - alpha, d1) / d1 if math.isinf(d2) else stats.f.ppf(1 - alpha, d1, d2)
-    assert sg.f_critical(d1, d2, alpha) == pytest.approx(expected, rel=1e-10)
+    assert dist.f_critical(d1, d2, alpha) == pytest.approx(expected, rel=1e-10)
 
 
 @pytest.mark.parametrize("df, alpha", [(4, 0.05), (9, 0.01), (19, 0.015), (math.inf, 0.05)])
 def test_t_noncentrality_gives_the_power(df: float, alpha: float) -> None:
     """At the returned noncentrality, scipy's noncentral t (or normal, df = inf) rejects 80% of the time."""
-    d = sg.t_noncentrality(df, alpha)
+    d = dist.t_noncentrality(df, alpha)
     if math.isinf(df):
         c = stats.norm.ppf(1 - alpha / 2)
         power = stats.norm.sf(c - d) + stats.norm.cdf(-c - d)
@@ -49,7 +51,7 @@ def test_t_noncentrality_gives_the_power(df: float, alpha: float) -> None:
 
 @pytest.mark.parametrize("d1, d2, alpha", [(3, 7, 0.05), (3, 2, 0.01), (2, 30, 0.001), (3, math.inf, 0.01)])
 def test_f_noncentrality_gives_the_power(d1: float, d2: float, alpha: float) -> None:
-    lam = sg.f_noncentrality(d1, d2, alpha)
+    lam = dist.f_noncentrality(d1, d2, alpha)
     if math.isinf(d2):
         power = stats.ncx2.sf(stats.chi2.ppf(1 - alpha, d1), d1, lam)
     else:
@@ -59,7 +61,7 @@ def test_f_noncentrality_gives_the_power(d1: float, d2: float, alpha: float) -> 
 
 @pytest.mark.parametrize("x, n", [(0, 300), (15, 300), (300, 300), (3, 10)])
 def test_clopper_pearson_is_the_beta_quantiles(x: int, n: int) -> None:
-    lo, hi = sg.clopper_pearson(x, n)
+    lo, hi = dist.clopper_pearson(x, n)
     assert lo == pytest.approx(0.0 if x == 0 else stats.beta.ppf(0.025, x, n - x + 1), abs=1e-12)
     assert hi == pytest.approx(1.0 if x == n else stats.beta.ppf(0.975, x + 1, n - x), abs=1e-12)
 
@@ -116,7 +118,7 @@ def test_prediction_detectable_difference_has_its_power() -> None:
     of the time (Monte Carlo, 4000 trials: standard error 0.0063), and at the level 5% of the time."""
     rng = np.random.default_rng(11)
     k, alpha = 6, 0.05
-    delta = sg.t_noncentrality(k - 1, alpha) * math.sqrt(1 + 1 / k)
+    delta = dist.t_noncentrality(k - 1, alpha) * math.sqrt(1 + 1 / k)
 
     def make(shift: float, rng: np.random.Generator) -> sg.PredictionTest:
         x = float(rng.normal(shift))
@@ -134,10 +136,10 @@ def test_curve_prediction_detectable_difference_has_its_power() -> None:
     chol = np.linalg.cholesky(cov)
     k, alpha = 12, 0.05
     q = np.ones(3) @ np.linalg.solve(cov, np.ones(3))
-    delta = math.sqrt(sg.f_noncentrality(3, k - 3, alpha) / (k / (k + 1) * q))
+    delta = math.sqrt(dist.f_noncentrality(3, k - 3, alpha) / (k / (k + 1) * q))
 
-    def make(shift: float, rng: np.random.Generator) -> sg.CurvePredictionTest:
-        return sg.CurvePredictionTest(chol @ rng.normal(size=3) + shift, (chol @ rng.normal(size=(3, k))).T)
+    def make(shift: float, rng: np.random.Generator) -> ct.CurvePredictionTest:
+        return ct.CurvePredictionTest(chol @ rng.normal(size=3) + shift, (chol @ rng.normal(size=(3, k))).T)
 
     assert _power_by_monte_carlo(make, delta, alpha, 3000, rng) == pytest.approx(0.8, abs=0.03)
     assert _power_by_monte_carlo(make, 0.0, alpha, 3000, rng) == pytest.approx(0.05, abs=0.013)
@@ -148,7 +150,7 @@ def test_permutation_test_counts_every_split() -> None:
     independent enumeration; perfectly separated samples give the smallest p, 2/252."""
     rng = np.random.default_rng(2)
     a, o = rng.normal(size=(5, 1)), rng.normal(size=(5, 1)) + 0.3
-    test = sg.PermutationTest(a, o)
+    test = ct.PermutationTest(a, o)
     both = np.vstack([a, o])[:, 0]
 
     def t2(first: tuple[int, ...]) -> float:
@@ -160,7 +162,7 @@ def test_permutation_test_counts_every_split() -> None:
     stats_ = [t2(c) for c in itertools.combinations(range(10), 5)]
     observed = t2((0, 1, 2, 3, 4))
     assert test.p_value == pytest.approx(np.mean(np.asarray(stats_) >= observed * (1 - 1e-12)), abs=1e-12)
-    apart = sg.PermutationTest(np.arange(5.0)[:, None], np.arange(5.0)[:, None] + 100)
+    apart = ct.PermutationTest(np.arange(5.0)[:, None], np.arange(5.0)[:, None] + 100)
     assert apart.p_value == pytest.approx(2 / 252) and apart.smallest_p == pytest.approx(2 / 252)
 
 
@@ -168,7 +170,7 @@ def test_permutation_test_level_is_exact_for_skewed_runs() -> None:
     """Exponential runs (far from normal), 5 against 7 in two blocks: rejections at 10% over 600 trials
     (standard error 0.012)."""
     rng = np.random.default_rng(8)
-    rejected = [sg.PermutationTest(rng.exponential(size=(5, 2)), rng.exponential(size=(7, 2))).p_value <= 0.1
+    rejected = [ct.PermutationTest(rng.exponential(size=(5, 2)), rng.exponential(size=(7, 2))).p_value <= 0.1
                 for _ in range(600)]
     assert np.mean(rejected) == pytest.approx(0.1, abs=0.036)
 
@@ -178,8 +180,8 @@ def test_permutation_detectable_difference_needs_resolution() -> None:
     against ten (1/3003) one is."""
     rng = np.random.default_rng(4)
     a = rng.normal(size=(5, 3))
-    assert sg.PermutationTest(a, rng.normal(size=(5, 3))).detectable_difference(0.05) == math.inf
-    assert math.isfinite(sg.PermutationTest(a, rng.normal(size=(10, 3))).detectable_difference(0.05))
+    assert ct.PermutationTest(a, rng.normal(size=(5, 3))).detectable_difference(0.05) == math.inf
+    assert math.isfinite(ct.PermutationTest(a, rng.normal(size=(10, 3))).detectable_difference(0.05))
 
 
 def test_benjamini_hochberg_by_hand() -> None:

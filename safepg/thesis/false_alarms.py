@@ -38,10 +38,12 @@ from typing import Any
 
 import numpy as np
 
+from safepg.curve_tests import CurvePredictionTest, block_means
+from safepg.distributions import clopper_pearson
 from safepg.learning import LearningRecord
 from safepg.options import FixedStep, Vanilla
 from safepg.runner import RunConfig
-from safepg.significance import CurvePredictionTest, PredictionTest, WelchTest, block_means, clopper_pearson
+from safepg.significance import PredictionTest, WelchTest
 from safepg.thesis.curve_bands import CURVE_BLOCKS
 from safepg.thesis.scorecard.verdicts import FLOOR_MARGIN, SEED_BLOCK
 from safepg.thesis.seed_rule import SEED_CAP, START_SEEDS

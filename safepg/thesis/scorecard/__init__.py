@@ -93,6 +93,8 @@ from safepg.thesis.scorecard.rules import (
     Note,
     Row,
     Status,
+)
+from safepg.thesis.scorecard.tolerances import (
     half_unit,
     in_prediction,
     intervals_overlap,

@@ -14,8 +14,9 @@ from safepg.thesis import authors, errata
 from safepg.thesis.experiments import LQG2D_GAMMA
 from safepg.thesis.lqg_settings import PRINTED_J_STAR, PRINTED_THETA_STAR
 from safepg.thesis.scorecard.builder import AuthorsColumn, Builder, RowSpec
-from safepg.thesis.scorecard.rules import GROUPS, NOTES, PRINTED, ClosedFormJ, PrintedDiscount, within_rounding
+from safepg.thesis.scorecard.rules import GROUPS, NOTES, PRINTED, ClosedFormJ, PrintedDiscount
 from safepg.thesis.scorecard.text import expr_tex, expr_text, signed
+from safepg.thesis.scorecard.tolerances import within_rounding
 
 
 def _theory_group(location: str) -> str:

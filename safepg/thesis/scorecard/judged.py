@@ -19,15 +19,9 @@ from safepg.thesis import authors
 from safepg.thesis.analysis import one_cell_spread
 from safepg.thesis.experiments import Experiment, method_of
 from safepg.thesis.scorecard import outputs
-from safepg.thesis.scorecard.rules import (
-    FROZEN_THETA,
-    TailRuns,
-    half_unit,
-    in_prediction,
-    intervals_overlap,
-    is_slip,
-)
+from safepg.thesis.scorecard.rules import FROZEN_THETA, TailRuns
 from safepg.thesis.scorecard.text import pct
+from safepg.thesis.scorecard.tolerances import half_unit, in_prediction, intervals_overlap, is_slip
 from safepg.thesis.scorecard.verdicts import RELEVANT_SHARE
 
 
