@@ -61,7 +61,7 @@ class PredictionTest:
     r"""A number printed from one run, against :math:`k` runs of ours.
 
     The printed number is an interval ``printed`` (its value give or take its rounding, or a reading
-    precision: "≈ 500" is [450, 550]); the statistic is the distance of our mean from it, less a
+    precision: "≈ 500" is 450 to 550); the statistic is the distance of our mean from it, less a
     ``resolution`` the quantity cannot resolve (an improvement ratio moves by whole updates),
 
     .. math:: T = \frac{\max(0,\ \mathrm{dist}(\bar x, [a, b]) - r)}{s_e\sqrt{1 + 1/k}},
@@ -363,7 +363,7 @@ def benjamini_hochberg(p_values: Sequence[float], q: float) -> tuple[np.ndarray,
     Raises
     ------
     ValueError
-        If ``q`` is not in (0, 1) or a p-value is outside [0, 1] or NaN.
+        If ``q`` is not in (0, 1) or a p-value is NaN or outside 0 to 1.
     """
     check_level(q, "q")
     p = np.asarray(p_values, dtype=float)

@@ -28,7 +28,7 @@ pytestmark = pytest.mark.browser
 
 STATUSES = ("reproduced", "reproduced only with the authors' unprinted settings",
             "reproduced only through an error in the authors' code", "agrees, but carries no information",
-            "differs (explained)", "open")
+            "inconclusive", "differs (explained)", "open")
 #: The statuses judged on the authors' column, whose rows link to the chapter's section on their settings.
 AUTHORS_COLUMN = STATUSES[1:3]
 

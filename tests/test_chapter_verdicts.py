@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import skip_or_fail
 from safepg.thesis.prefetch import chapters
 from safepg.thesis.scorecard import STATUSES, row_id_of, scorecard
 from safepg.thesis.scorecard.export import STATUS_PREFIX
@@ -67,7 +68,7 @@ def test_the_verdict_patterns_catch_a_verdict() -> None:
 
 def test_every_glued_status_is_its_row_s_status_now() -> None:
     if not (RESULTS / "table-5.2").is_dir():
-        pytest.skip("the book's runs are not stored (make book computes them)")
+        skip_or_fail("the book's runs are not stored: run `make book`")
     rows = {r.id: r.status for r in scorecard(root=RESULTS)}
     quoted = 0
     for notebook in [*PAGES, BOOK / "intro.md"]:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import skip_or_fail
 from safepg.thesis import false_alarms as fa
 from safepg.thesis.seed_rule import START_SEEDS
 
@@ -23,7 +24,7 @@ RESULTS = Path(__file__).resolve().parents[1] / "results"
 def checks() -> list[fa.AlarmCheck]:
     path = fa.checks_path(RESULTS)
     if not path.exists():
-        pytest.skip("the false-alarm checks are not stored (make book computes them)")
+        skip_or_fail("the false-alarm checks are not stored: run `make book`")
     return fa.checks_from_dicts(json.loads(path.read_text(encoding="utf-8")))
 
 

@@ -82,7 +82,7 @@ def test_one_plotted_value_changes_the_hash_at_the_printed_precision_only() -> N
 
 
 def test_use_style_registers_the_digest_only_when_asked_and_only_in_a_kernel() -> None:
-    from safepg.thesis import figure_digest as fd
+    from safepg import figure_digest as fd
     from safepg.thesis import plotting
 
     plotting.use_style(digest=True)  # no IPython kernel here: nothing to register, and no error

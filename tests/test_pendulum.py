@@ -10,13 +10,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from conftest import import_or_fail
 from safepg.constants import TaskConstants
 from safepg.envs.pendulum import Pendulum, angle_normalize, gymnasium_step, step_dynamics, step_reward
 from safepg.policies import LinearGaussianPolicy
 from safepg.streams import batch_key, trajectory_draws
 from safepg.tasks import task_hooks
 
-gym = pytest.importorskip("gymnasium")
+gym = import_or_fail("gymnasium")
 from gymnasium.envs.classic_control.pendulum import PendulumEnv  # noqa: E402
 
 ONE_STEP = 1e-12

@@ -228,8 +228,9 @@ def checks_from_dicts(data: Sequence[Mapping[str, Any]]) -> list[AlarmCheck]:
 #: The folder of the stored checks, inside the results folder.
 FOLDER = "false-alarms"
 #: What the checks are computed from: these modules' sources and the trial configurations' keys.
-_SOURCES = ("significance.py", "stats.py", "thesis/false_alarms.py", "thesis/seed_rule.py",
-            "thesis/scorecard/judged.py", "thesis/scorecard/verdicts.py")
+_SOURCES = ("significance.py", "curve_tests.py", "distributions.py", "stats.py", "thesis/false_alarms.py",
+            "thesis/seed_rule.py", "thesis/scorecard/judged.py", "thesis/scorecard/tolerances.py",
+            "thesis/scorecard/verdicts.py")
 
 
 def checks_key(trials: int = TRIALS) -> str:

@@ -76,7 +76,8 @@ def _key(source: str) -> tuple[str, str]:
 
 def planned_campaign(rows: Sequence[Row], campaign: Campaign) -> Campaign:
     """``campaign`` with the seeds the rule asks for on ``rows`` where they are more than it and the
-    experiment's own (never fewer: what is stored stays counted)."""
+    experiment's own (never fewer: a round of :func:`plan_seeds` never takes back what an earlier one gave,
+    so the rule ends)."""
     seeds = dict(campaign.seeds)
     for source, n in wanted_seeds(rows).items():
         name, key = _key(source)
@@ -101,11 +102,16 @@ def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -
                stream: TextIO | None = None) -> Campaign:
     """Apply the rule to the results folder ``root`` until no column asks for more seeds.
 
+    The rule starts from the starting counts whatever the folder's campaign says, so the campaign it
+    writes is a function of the runs alone: a folder that a change of the rule left with more seeds
+    than the rule now gives ends with the same campaign as a folder filled from empty (the runs beyond
+    it stay stored, unread, and are used again if the rule asks for them).
+
     Parameters
     ----------
     root : Path
-        The results folder; its campaign (:func:`~safepg.thesis.experiment_store.read_campaign`) gets the
-        added seeds.
+        The results folder; its campaign (:func:`~safepg.thesis.experiment_store.read_campaign`) becomes
+        the rule's: its first seed kept, its seeds the starting counts and what the rule adds.
     build : callable
         The scorecard's rows from the runs stored in a folder (``build(root)``).
     jobs : int
@@ -125,7 +131,9 @@ def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -
     """
     stream = stream or sys.stdout
     run = run or (lambda names, folder, n: run_experiments(names, jobs=n, root=folder, progress=False))
-    campaign = read_campaign(root)
+    campaign = Campaign(read_campaign(root).first_seed, {})
+    if read_campaign(root) != campaign:
+        write_campaign(campaign, root)
     for _ in range(rounds):
         planned = planned_campaign(build(root), campaign)
         more = {k: v for k, v in planned.seeds.items() if campaign.seeds.get(k) != v}
