@@ -236,7 +236,8 @@ def _cmd_two_draws(args: argparse.Namespace) -> dict[str, Any] | None:
     from safepg.thesis.scorecard.rows import build_rows
 
     started = time.monotonic()
-    draws.run_draw(Path(args.root), jobs=args.jobs)
+    # With --json, standard output is the comparison alone: the draw's progress goes to standard error.
+    draws.run_draw(Path(args.root), jobs=args.jobs, stream=sys.stderr if args.json else sys.stdout)
     seconds = time.monotonic() - started
     c = draws.compare_draws(build_rows(results_dir()), build_rows(Path(args.root)))
     if args.json:
