@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import shutil
 import subprocess
 import tempfile
@@ -45,6 +44,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from machine import cpu
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "js_learner_timings.json"
@@ -275,7 +275,7 @@ def main() -> None:
     result = {
         "what": "best of --repeat calls; batch: N = 1e5 trajectories, H = 20, random numbers included; run: "
                 "Algorithm 4.1, G(PO)MDP, Bernstein (e.r.), delta 0.95, sigma 1, 1e6 trajectories",
-        "machine": {"cpu": platform.processor() or platform.machine(), "cores": __import__("os").cpu_count(),
+        "machine": {**cpu(),
                     "node": subprocess.run([node, "--version"], capture_output=True, text=True).stdout.strip(),
                     "numba": numba.__version__, "numba_threads": 1,
                     "load_average_1min": round(__import__("os").getloadavg()[0], 2)},

@@ -23,13 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
 import textwrap
 import time
 from pathlib import Path
+
+from machine import cpu
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = Path(__file__).with_name("pendulum_timings.json")
@@ -66,15 +67,6 @@ CAMPAIGN = textwrap.dedent("""
     res = run_comparison(pendulum_comparison(), Path(sys.argv[1]))
     print(json.dumps({"seconds": time.perf_counter() - t0, "runs": sum(len(v) for v in res.records.values())}))
 """)
-
-
-def cpu() -> dict[str, object]:
-    """The CPU's model name, core count and vector extensions, from /proc/cpuinfo."""
-    info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
-    name = next((line.split(":", 1)[1].strip() for line in info.splitlines() if line.startswith("model name")),
-                platform.processor())
-    flags = set(next((line.split(":", 1)[1].split() for line in info.splitlines() if line.startswith("flags")), []))
-    return {"model": name, "cores": os.cpu_count(), "avx2": "avx2" in flags, "avx512f": "avx512f" in flags}
 
 
 def run(code: str, args: list[str], env: dict[str, str]) -> dict[str, object]:
