@@ -229,6 +229,27 @@ def test_experiments_dispatched_together_store_what_each_alone_stores(tmp_path):
                                              "run-book: table-5.4-authors: stored (2 runs)"]
 
 
+def test_one_experiment_asked_twice_is_computed_and_counted_once(tmp_path, monkeypatch):
+    """Two chapters may ask for one experiment at two seed counts (the scorecard's cart-pole baseline at
+    5 and 10): the larger count is computed, each seed once, and the line counts each run once."""
+    computed = []
+    compute = prefetch.runner._compute_task
+
+    def counting(i, cfg, seed, theta0, single_thread):
+        computed.append((cfg.name, seed))
+        return compute(i, cfg, seed, theta0, single_thread)
+
+    monkeypatch.setattr(prefetch.runner, "_compute_task", counting)
+    tasks = [_small(1), _small(2), prefetch.Task("cartpole", "cartpole-baseline-authors", seeds=1)]
+    out = io.StringIO()
+    got = prefetch.prefetch_experiments(tasks, tmp_path, jobs=1, stream=out, tty=False)
+    assert got == dict.fromkeys(["table-5.1", "cartpole-baseline-authors"], "computed")
+    lines = out.getvalue().splitlines()
+    assert lines[0] == "run-book: 2 experiments: computing 49 of 49 runs (0 stored)"
+    assert lines[-1].startswith("run-book: 2 experiments: done, 49/49 runs, ")
+    assert len(computed) == len(set(computed)) == 49
+
+
 def test_an_interrupted_task_says_stopped(tmp_path, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

@@ -245,6 +245,22 @@ def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO |
     return "computed"
 
 
+def _one_per_experiment(tasks: list[Task]) -> list[Task]:
+    """One task per experiment and budget, the one with the most seeds, in the order first asked: two
+    chapters may ask for one experiment at two counts (the scorecard's cart-pole baseline at 5 and 10),
+    and the same seeds of one folder must not be computed, nor counted, twice."""
+    best: dict[tuple[str, int | None], Task] = {}
+    for t in tasks:
+        key = (t.name, t.budget)
+        if key not in best or _total_seeds(t) > _total_seeds(best[key]):
+            best[key] = t
+    return list(best.values())
+
+
+def _total_seeds(t: Task) -> int:
+    return scaled(get_experiment(t.name), seeds=t.seeds, budget=t.budget).seeds
+
+
 def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: TextIO | None = None,
                          tty: bool | None = None, interval: float | None = None,
                          book: Path = BOOK) -> dict[str, str]:
@@ -257,7 +273,7 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
     stream = stream or sys.stdout
     done: dict[str, str] = {}
     pending = []
-    for t in tasks:
+    for t in _one_per_experiment(tasks):
         exp, folder, missing = _missing_runs(t, root)
         if missing:
             pending.append((t, exp, folder, missing))
