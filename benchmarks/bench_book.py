@@ -38,6 +38,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from machine import cpu
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = Path(__file__).with_name("book_timings.json")
@@ -160,19 +161,13 @@ def phases_markdown(phases: dict[str, dict[str, float]]) -> str:
 
 
 def machine() -> dict[str, object]:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    info = cpu()
     try:
         load = os.getloadavg()[0]
     except OSError:
         load = None
-    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(), "numpy": np.__version__,
+    return {"cpu": info["model"], "cores": info["cores"], "avx2": info["avx2"], "avx512f": info["avx512f"],
+            "numba_cpu_name": info["numba_cpu_name"], "python": platform.python_version(), "numpy": np.__version__,
             "load_average_1min_at_end": load}
 
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -46,13 +46,18 @@ from safepg.distributions import (
 
 
 # ------------------------------------------------------------------ small statistics, CPU-independent
-def _mean_sd(values: Sequence[float] | np.ndarray) -> tuple[float, float, int]:
+def _store_runs(test: Any, values: Sequence[float] | np.ndarray) -> None:
+    """Set a frozen test's ``values`` (as floats), ``mean`` and ``sd`` (ddof = 1) from our runs, of which it
+    needs two."""
     x = np.asarray(values, dtype=float)
     if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)):
         raise ValueError(f"values must be a non-empty 1-D sequence of finite numbers, got shape {x.shape}")
+    if x.size < 2:
+        raise ValueError(f"values must hold at least two runs, got {x.size}")
     m = float(x.mean())
-    sd = float(np.sqrt(np.sum((x - m) ** 2) / (x.size - 1))) if x.size > 1 else 0.0
-    return m, sd, int(x.size)
+    object.__setattr__(test, "values", tuple(float(v) for v in x))
+    object.__setattr__(test, "mean", m)
+    object.__setattr__(test, "sd", float(np.sqrt(np.sum((x - m) ** 2) / (x.size - 1))))
 
 
 # ------------------------------------------------------------------ the tests
@@ -106,13 +111,8 @@ class PredictionTest:
             raise ValueError(f"printed must be an interval (low, high) of finite numbers, got {self.printed!r}")
         if self.resolution < 0 or self.sd_floor < 0:
             raise ValueError(f"resolution and sd_floor must be >= 0, got {self.resolution!r} and {self.sd_floor!r}")
-        m, sd, k = _mean_sd(self.values)
-        if k < 2:
-            raise ValueError(f"values must hold at least two runs, got {k}")
+        _store_runs(self, self.values)
         object.__setattr__(self, "printed", (lo, hi))
-        object.__setattr__(self, "values", tuple(float(v) for v in self.values))
-        object.__setattr__(self, "mean", m)
-        object.__setattr__(self, "sd", sd)
 
     @property
     def seeds(self) -> int:
@@ -215,13 +215,8 @@ class WelchTest:
             raise ValueError(f"runs must be an integer >= 2, got {self.runs!r}")
         if self.resolution < 0:
             raise ValueError(f"resolution must be >= 0, got {self.resolution!r}")
-        m, sd, k = _mean_sd(self.values)
-        if k < 2:
-            raise ValueError(f"values must hold at least two runs, got {k}")
+        _store_runs(self, self.values)
         object.__setattr__(self, "printed_interval", (lo, hi))
-        object.__setattr__(self, "values", tuple(float(v) for v in self.values))
-        object.__setattr__(self, "mean", m)
-        object.__setattr__(self, "sd", sd)
 
     @property
     def seeds(self) -> int:
