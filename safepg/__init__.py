@@ -42,10 +42,9 @@ from safepg.bounds import ErrorBound, error_bound
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
 from safepg.estimators import gpomdp, gradient_samples, reinforce
-from safepg.learning import LearningRecord, adaptive_pg, learn, vanilla_pg
+from safepg.learning import adaptive_pg, learn, vanilla_pg
 from safepg.meta import (
     coordinate_step,
-    guaranteed_improvement,
     n_star_closed_form,
     n_star_search,
     n_zero,
@@ -56,7 +55,8 @@ from safepg.meta import (
 )
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
-from safepg.record import on_trajectories
+from safepg.record import LearningRecord, on_trajectories
+from safepg.results import load, plot_runs, summarise
 from safepg.trajectories import Trajectories
 
 #: The package's version.
@@ -84,16 +84,18 @@ __all__ = [
     "error_bound",
     "gpomdp",
     "gradient_samples",
-    "guaranteed_improvement",
     "learn",
+    "load",
     "n_star_closed_form",
     "n_star_search",
     "n_zero",
     "on_trajectories",
     "optimal_batch_size",
     "penalty_constant",
+    "plot_runs",
     "reinforce",
     "scalar_step",
+    "summarise",
     "upsilon",
     "vanilla_pg",
 ]

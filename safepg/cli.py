@@ -10,20 +10,22 @@ import json
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from decimal import Decimal, InvalidOperation
-from typing import Any
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
 from safepg.envs.lqg import LQG
 from safepg.learning import learn
+from safepg.option_fields import option_field, option_fields
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.store import DamagedRunsError, DamagedRunWarning, results_dir
 from safepg.thesis import experiment_store, experiments, report
 
 #: The tasks of ``learn`` (those with a closed-form J, which its summary reports).
 TASKS = {"lqg1d": LQG.thesis_1d, "lqg2d": LQG.thesis_2d}
+_Option = TypeVar("_Option")
 
 
 def integer(text: str) -> int:
@@ -69,18 +71,88 @@ def jobs_integer(text: str) -> int:
     return value
 
 
-def range_value(text: str) -> str | float:
-    """argparse type of ``--range``: ``lemma``, ``empirical`` or a number (ErrorModel.range)."""
-    if text in ("lemma", "empirical"):
-        return text
-    try:
-        return float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be 'lemma', 'empirical' or a number, got {text!r}") from None
+def choice_or_number(choices: tuple[str, ...]) -> Callable[[str], str | float]:
+    """argparse type of a field that holds one of ``choices`` or a number (ErrorModel.range)."""
+    def value(text: str) -> str | float:
+        if text in choices:
+            return text
+        try:
+            return float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {', '.join(repr(c) for c in choices)} or a number, "
+                                             f"got {text!r}") from None
+    return value
 
 
-def _learn_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    # Each flag is a field of an option object (safepg.options), spelt as that field.
+class OptionFlag(NamedTuple):
+    """A ``learn`` flag that sets the field ``field`` of the option object ``owner``."""
+
+    flag: str
+    owner: type
+    field: str
+    #: What giving the flag does, for a flag whose presence chooses its object (vanilla PG, a
+    #: SafeStep, a Target): such a flag has no default, whatever the field's.
+    chooses: str | None = None
+
+
+#: The option objects each field of which is a ``learn`` flag spelt as the field (``n_min`` is
+#: ``--n-min``), with what their group's title adds to the class's name.
+OPTION_GROUPS: dict[type, str] = {Gradient: "", ErrorModel: "Algorithm 4.1, or a SafeStep", Batches: "Algorithm 4.1",
+                                  Departures: "Algorithm 4.1, the authors' ways of running it"}
+#: The fixed-batch method's flags: they set fields of several objects, some under other names
+#: (two objects have a ``kind``), so each is listed.
+VANILLA_FLAGS = (
+    OptionFlag("--batch-size", Vanilla, "batch_size", "run vanilla PG with this batch size instead of Algorithm 4.1"),
+    OptionFlag("--alpha", FixedStep, "alpha"),
+    OptionFlag("--safe-step", SafeStep, "kind",
+               "a SafeStep of this kind, with the ErrorModel flags, instead of a fixed --alpha"),
+    OptionFlag("--kind", FixedStep, "kind"),
+    OptionFlag("--target", Target, "value", "stop once a batch's mean return reaches it"),
+    OptionFlag("--update", Target, "update"),
+)
+
+
+def _group_flags(cls: type) -> tuple[OptionFlag, ...]:
+    """The flags of an object of :data:`OPTION_GROUPS`: one per field, spelt as the field."""
+    return tuple(OptionFlag(f"--{f.name.replace('_', '-')}", cls, f.name) for f in option_fields(cls))
+
+
+def learn_flags() -> tuple[OptionFlag, ...]:
+    """Every ``learn`` flag that sets an option object's field, in the order ``--help`` lists them."""
+    return sum((_group_flags(cls) for cls in OPTION_GROUPS), ()) + VANILLA_FLAGS
+
+
+def _add_option(group: argparse._ArgumentGroup, o: OptionFlag, group_owner: type) -> None:
+    """``o``'s argument: its default, values and help read from its field (safepg.option_fields)."""
+    f = option_field(o.owner, o.field)
+    default = None if f.required or o.chooses else f.default
+    kw: dict[str, Any] = {"default": default}
+    if f.boolean:
+        # A switch that is on by default can only be turned off (--no-baseline).
+        kw["action"] = argparse.BooleanOptionalAction if default else "store_true"
+    elif f.choices and f.number:
+        kw["type"] = choice_or_number(f.choices)
+        kw["metavar"] = "{" + ",".join(f.choices + ("NUMBER",)) + "}"
+    elif f.choices and not f.integer:
+        kw["choices"] = list(f.choices)
+    elif f.number:
+        kw["type"] = float
+    elif f.integer and not f.choices:
+        # Counts as users type them (1e6); the option object refuses a count below its own minimum.
+        kw["type"] = positive_integer
+    else:
+        raise TypeError(f"{o.flag}: no command-line spelling of {o.owner.__name__}.{o.field}")
+    where = "" if o.owner is group_owner else f"{o.owner.__name__}.{o.field}: "
+    text = where + f.help + (f" Given: {o.chooses}." if o.chooses else "")
+    # argparse formats help with %: the docstring's own % are escaped; the default is argparse's own.
+    shown = default is not None and default is not False
+    kw["help"] = text.replace("%", "%%") + (" (default: %(default)s)" if shown else "")
+    group.add_argument(o.flag, **kw)
+
+
+def _learn_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> argparse.ArgumentParser:
+    # Each flag is a field of an option object (safepg.options), spelt as that field; its default,
+    # values and help are the dataclass's (learn_flags), so that they cannot drift apart.
     p = sub.add_parser("learn", help="run one learning loop and print a JSON summary",
                        description="Algorithm 4.1 (Adaptive), or vanilla PG with --batch-size (Vanilla). Each "
                                    "flag is the field of the option object named in its group.")
@@ -92,44 +164,29 @@ def _learn_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> N
     p.add_argument("--stop-on-divergence", action="store_true",
                    help="end the run when the gradient estimate is not finite (default: an error)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    g = p.add_argument_group("Gradient")
-    g.add_argument("--estimator", choices=["reinforce", "gpomdp"], default="gpomdp")
-    g.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
-                   help="the variance-minimising baseline (--no-baseline: b = 0)")
-    g.add_argument("--score-action", choices=["clipped", "raw"], default="clipped",
-                   help="score the clipped action (authors' code) or the sampled one (unbiased)")
-    g = p.add_argument_group("ErrorModel (Algorithm 4.1, or a SafeStep)")
-    g.add_argument("--bound", choices=["chebyshev", "hoeffding", "bernstein"], default="chebyshev")
-    g.add_argument("--delta", type=float, default=0.95)
-    g.add_argument("--range", type=range_value, default="lemma", help="lemma, empirical, or a number")
-    g = p.add_argument_group("Batches (Algorithm 4.1)")
-    g.add_argument("--n-min", type=positive_integer, default=100)
-    g.add_argument("--n-max", type=positive_integer, default=500_000)
-    g.add_argument("--first", type=positive_integer, help="the first batch's size (default: N_min)")
-    g = p.add_argument_group("Departures (Algorithm 4.1, the authors' ways of running it)")
-    for name in ("batch_constants", "maxima", "unguarded_step"):
-        g.add_argument(f"--{name.replace('_', '-')}", action="store_true")
+    for cls, note in OPTION_GROUPS.items():
+        g = p.add_argument_group(f"{cls.__name__} ({note})" if note else cls.__name__)
+        for o in _group_flags(cls):
+            _add_option(g, o, cls)
     g = p.add_argument_group("Vanilla (fixed batch size)")
-    g.add_argument("--batch-size", type=positive_integer, help="run vanilla PG with this batch size")
-    g.add_argument("--alpha", type=float, help="FixedStep: the step size")
-    g.add_argument("--safe-step", choices=["scalar", "coordinate"],
-                   help="SafeStep of this kind, with the ErrorModel flags, instead of a fixed alpha")
-    g.add_argument("--kind", choices=["scalar", "coordinate"], default="scalar",
-                   help="FixedStep: update all components or only the largest")
-    g.add_argument("--target", type=float, help="Target: stop once a batch's mean return reaches it")
-    g.add_argument("--update", action="store_true", help="Target: the batch that reaches it still updates theta")
+    for o in VANILLA_FLAGS:
+        _add_option(g, o, Vanilla)
+    return p
+
+
+def _options(args: argparse.Namespace, cls: type[_Option]) -> _Option:
+    """The option object of :data:`OPTION_GROUPS` ``cls``, from the flags of its fields."""
+    return cls(**{f.name: getattr(args, f.name) for f in option_fields(cls)})
 
 
 def _method(args: argparse.Namespace) -> Adaptive | Vanilla:
     """The method the ``learn`` flags describe, as option objects (each checks its own values)."""
-    gradient = Gradient(args.estimator, args.baseline, args.score_action)
-    error = ErrorModel(args.bound, args.delta, args.range)
+    gradient, error = _options(args, Gradient), _options(args, ErrorModel)
     if args.batch_size is None:
         for flag in ("alpha", "safe_step", "target"):
             if getattr(args, flag) is not None:
                 raise ValueError(f"--{flag.replace('_', '-')} is an option of vanilla PG: give --batch-size too")
-        return Adaptive(gradient, error, Batches(args.n_min, args.n_max, args.first),
-                        Departures(args.batch_constants, args.maxima, args.unguarded_step))
+        return Adaptive(gradient, error, _options(args, Batches), _options(args, Departures))
     if (args.alpha is None) == (args.safe_step is None):
         raise ValueError("--batch-size needs a step: --alpha (a FixedStep) or --safe-step (a SafeStep)")
     step = FixedStep(args.alpha, args.kind) if args.alpha is not None else SafeStep(args.safe_step, error)
@@ -177,6 +234,14 @@ def _experiment_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]
     p.add_argument("--budget", type=positive_integer)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_report)
+    p = sub.add_parser("prune", help="remove the stored runs of definitions that no experiment asks for any longer")
+    p.add_argument("names", nargs="*", help="experiments to prune (default: every experiment the book's chapters "
+                                            "compute, at the seeds and budgets they ask for)")
+    p.add_argument("--budget", type=positive_integer,
+                   help="the named experiments' budget whose runs are kept (default: the thesis's)")
+    p.add_argument("--dry-run", action="store_true", help="only list what would be removed")
+    p.add_argument("--json", action="store_true", help="print {\"removed\": [paths]}")
+    p.set_defaults(func=_cmd_prune)
     p = sub.add_parser("run-book", help="compute what the book's chapters need, with progress (make book)")
     p.add_argument("--book", help="the chapters' folder (default: book/ of this clone)")
     p.add_argument("--root", help="the results store (default: results/ beside the book's folder)")
@@ -213,6 +278,31 @@ def _cmd_run(args: argparse.Namespace) -> dict[str, Any]:
     exp = experiments.scaled(experiments.get_experiment(args.name), args.seeds, args.budget)
     recs = experiment_store.run_experiment(exp, jobs=args.jobs, progress=not args.quiet)
     return report.report(exp, recs)
+
+
+def _cmd_prune(args: argparse.Namespace) -> dict[str, Any] | None:
+    from safepg import runner
+
+    if args.names:
+        exps = [experiments.scaled(experiments.get_experiment(n), budget=args.budget) for n in args.names]
+    else:
+        from safepg.thesis import prefetch
+
+        if args.budget is not None:
+            raise ValueError("budget must come with the names of the experiments it applies to")
+        exps = [experiments.scaled(experiments.get_experiment(t.name), seeds=t.seeds, budget=t.budget)
+                for t in prefetch.book_tasks() if t.kind == "experiment"]
+    asked: dict[Any, list[Any]] = {}
+    for exp in exps:  # an experiment asked for at two budgets keeps both definitions in its folder
+        asked.setdefault(experiment_store.experiment_folder(exp), []).extend(exp.configs)
+    removed = [str(p) for folder, configs in asked.items() for p in runner.prune(folder, configs, args.dry_run)]
+    if args.json:
+        return {"removed": removed}
+    for path in removed:
+        print(f"{'would remove' if args.dry_run else 'removed'} {path}")
+    print(f"{len(removed)} run file{'s' * (len(removed) != 1)} of definitions no longer asked for "
+          f"{'found' if args.dry_run else 'removed'} under {results_dir()}")
+    return None
 
 
 def _cmd_run_book(args: argparse.Namespace) -> None:

@@ -44,7 +44,6 @@ from safepg.bounds import (
 )
 from safepg.constants import TaskConstants
 from safepg.envs.pendulum import Pendulum
-from safepg.learning import LearningRecord
 from safepg.meta import (
     coordinate_step,
     guaranteed_improvement,
@@ -55,7 +54,8 @@ from safepg.meta import (
 )
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Vanilla
 from safepg.policies import LinearGaussianPolicy
-from safepg.runner import RunConfig, RunGroup, run_groups
+from safepg.record import LearningRecord
+from safepg.runner import OnComputed, RunConfig, RunGroup, run_groups
 from safepg.safety import MC_LOOKS_OUR_RUNS, MonteCarloOutcomes
 from safepg.safety_store import is_measured, measure_runs
 from safepg.stats import BOOTSTRAP_REPS, aggregate_scores, improvement_interval, probability_of_improvement
@@ -285,7 +285,8 @@ def choose_steps(scores: Mapping[int, Mapping[float, float]]) -> dict[int, float
 
 
 def run_comparison(cmp: Comparison, root: Path, jobs: int = -1, progress: bool = False,
-                   report: Callable[[str], object] | None = None) -> ComparisonResult:
+                   report: Callable[[str], object] | None = None,
+                   on_computed: OnComputed | None = None) -> ComparisonResult:
     """Compute what is missing of ``cmp`` into ``root`` and return it all (:class:`ComparisonResult`).
 
     The step search and the adaptive variants are dispatched together; then the fixed-batch
@@ -304,18 +305,22 @@ def run_comparison(cmp: Comparison, root: Path, jobs: int = -1, progress: bool =
         tqdm bars of the runs.
     report : callable, optional
         Called with one line as each stage ends.
+    on_computed : callable, optional
+        Passed to :func:`safepg.runner.run_groups`: called for each folder runs were computed in, with
+        how long they took (nothing is written for it otherwise).
     """
     say = report or (lambda _line: None)
     folder = cmp.folder(root)
     search = RunGroup(cmp.search_configs(), cmp.search.seeds, folder / "search", first_seed=cmp.search.first_seed)
     adaptive = RunGroup(cmp.adaptive, cmp.seeds, folder)
-    search_records, adaptive_records = run_groups([search, adaptive], jobs, progress, f"{cmp.name}: search, adaptive")
+    search_records, adaptive_records = run_groups([search, adaptive], jobs, progress, f"{cmp.name}: search, adaptive",
+                                                  on_computed)
     scores_by_step = _search_scores(cmp, search_records)
     steps = choose_steps(scores_by_step)
     say(f"fixed steps chosen on seeds {cmp.search.first_seed}-{cmp.search.first_seed + cmp.search.seeds - 1}: "
         + ", ".join(f"N = {n}: {a:g}" for n, a in steps.items()))
     fixed_records = run_groups([RunGroup(cmp.fixed_configs(steps), cmp.seeds, folder)], jobs, progress,
-                               f"{cmp.name}: fixed batches")[0]
+                               f"{cmp.name}: fixed batches", on_computed)[0]
     records = {**adaptive_records, **fixed_records}
     say(f"runs: {sum(len(v) for v in records.values())} of {cmp.seeds * len(records)}")
     safety = {}

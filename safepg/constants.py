@@ -3,36 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 
 from safepg import portable
 
+# BoundedTask lives in safepg.tasks with the rest of a task's interface (this module reads
+# tasks, safepg.tasks does not need it); it is imported here for the name it had.
+from safepg.tasks import BoundedTask, constants_settings
+
 #: Values of the ``horizon_term`` of :class:`TaskConstants`.
 HORIZON_TERMS = ("effective", "truncated", "horizon")
-
-
-class BoundedTask(Protocol):
-    """A task's bounds of Assumption 4.2.1 and its horizon: read-only, as attributes or properties."""
-
-    @property
-    def reward_bound(self) -> float: ...
-
-    @property
-    def feature_bound(self) -> float: ...
-
-    @property
-    def action_volume(self) -> float: ...
-
-    @property
-    def action_bound(self) -> float: ...
-
-    @property
-    def gamma(self) -> float: ...
-
-    @property
-    def horizon(self) -> int: ...
 
 
 @dataclass(frozen=True)
@@ -45,8 +26,8 @@ class TaskConstants:
         Bound on |reward|.
     M_phi : float
         Bound on |phi_i(s)| (Assumption 4.2.1).
-    A_volume : float
-        Volume |A| of the action space.
+    action_volume : float
+        Volume |A| of the action space (the tasks' ``action_volume``).
     A_bar : float
         Bound on |a| (Lemma 4.3.3).
     gamma : float
@@ -65,7 +46,7 @@ class TaskConstants:
 
     R: float
     M_phi: float
-    A_volume: float
+    action_volume: float
     A_bar: float
     gamma: float
     H: int
@@ -73,7 +54,7 @@ class TaskConstants:
     horizon_term: str = "effective"
 
     def __post_init__(self) -> None:
-        for name in ("R", "M_phi", "A_volume", "A_bar", "sigma"):
+        for name in ("R", "M_phi", "action_volume", "A_bar", "sigma"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v}")
@@ -101,21 +82,29 @@ class TaskConstants:
     def from_task(cls, task: BoundedTask, sigma: float) -> TaskConstants:
         """Read the constants off an environment for a policy of std ``sigma``.
 
-        A task without a ``horizon_term`` attribute gets ``"effective"`` (Theorem 4.2.3 as printed).
-        A task with a ``constants_gamma`` other than None writes the constants in that discount
-        instead of its ``gamma`` (the cart-pole's authors' setting: undiscounted returns, gamma =
-        0.9 in the penalty constant).
+        The horizon term and the discount of the constants are the task's
+        :class:`~safepg.tasks.ConstantsSettings` (:func:`~safepg.tasks.constants_settings`): a
+        task that does not declare them gets ``"effective"`` (Theorem 4.2.3 as printed) and its
+        own ``gamma``. A ``constants_gamma`` other than None writes the constants in that
+        discount instead of the task's ``gamma`` (the cart-pole's authors' setting: undiscounted
+        returns, gamma = 0.9 in the penalty constant).
+
+        Raises
+        ------
+        TypeError
+            The task defines ``horizon_term`` or ``constants_gamma`` without declaring
+            :class:`~safepg.tasks.ConstantsSettings`, or declares it without both.
         """
-        gamma = getattr(task, "constants_gamma", None)
+        settings = constants_settings(task)
         return cls(
             R=task.reward_bound,
             M_phi=task.feature_bound,
-            A_volume=task.action_volume,
+            action_volume=task.action_volume,
             A_bar=task.action_bound,
-            gamma=task.gamma if gamma is None else gamma,
+            gamma=task.gamma if settings.constants_gamma is None else settings.constants_gamma,
             H=task.horizon,
             sigma=float(sigma),
-            horizon_term=getattr(task, "horizon_term", "effective"),
+            horizon_term=settings.horizon_term,
         )
 
 

@@ -26,9 +26,13 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import inspect
 import math
+import sys
+import types
+import typing
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -91,13 +95,101 @@ def _type_of(name: str) -> type:
     return cls
 
 
+#: How a field's numbers are written: as floats, as ints, or as given (a field that declares neither).
+NumberKind = Literal["float", "int"] | None
+
+
+def _number_kind(hint: Any) -> NumberKind:
+    """``"float"`` if the annotation admits a float (``float``, ``float | None``, ``tuple[float, ...]``,
+    ``np.ndarray | float``, ``Literal[...] | float``), else ``"int"`` if it admits an int, else None."""
+    found: set[type] = set()
+
+    def walk(h: Any) -> None:
+        if h is float or h is int:
+            found.add(h)
+        elif typing.get_origin(h) is not Literal:
+            for arg in typing.get_args(h):
+                walk(arg)
+
+    walk(hint)
+    return "float" if float in found else "int" if int in found else None
+
+
+def _annotations(cls: type) -> dict[str, Any]:
+    """The declared annotations of ``cls``'s definition fields, each evaluated on its own.
+
+    A dataclass's fields come from its classes' annotations (through the MRO); a class that writes
+    itself with ``definition()`` declares its fields as its ``__init__``'s parameters. Each string
+    annotation (``from __future__ import annotations``) is evaluated in its class's module; one that
+    does not evaluate (a name imported only for type checking) declares nothing.
+    """
+    raw: dict[str, tuple[Any, dict[str, Any]]] = {}
+    if dataclasses.is_dataclass(cls) and not hasattr(cls, "definition"):
+        for klass in reversed(cls.__mro__):
+            module = vars(sys.modules.get(klass.__module__, types.ModuleType("_")))
+            for name, hint in vars(klass).get("__annotations__", {}).items():
+                raw[name] = (hint, module)
+    else:
+        init = inspect.unwrap(cls.__init__)  # type: ignore[misc]
+        module = vars(sys.modules.get(init.__module__, types.ModuleType("_")))
+        for name, hint in getattr(init, "__annotations__", {}).items():
+            raw[name] = (hint, module)
+    out = {}
+    for name, (hint, module) in raw.items():
+        if isinstance(hint, str):
+            try:
+                hint = eval(hint, dict(module))  # noqa: S307 - the class's own annotation, in its own module
+            except Exception:  # a name only imported under TYPE_CHECKING: no declared number kind
+                continue
+        out[name] = hint
+    return out
+
+
+_DECLARED: dict[type, dict[str, NumberKind]] = {}
+
+
+def declared_numbers(cls: type) -> dict[str, NumberKind]:
+    """How each definition field of ``cls`` writes its numbers, from the field's declared type.
+
+    >>> declared_numbers(Batches)
+    {'n_min': 'int', 'n_max': 'int', 'first': 'int'}
+    """
+    if cls not in _DECLARED:  # read once per class: to_dict runs for every key
+        _DECLARED[cls] = {name: kind for name, hint in _annotations(cls).items()
+                          if name != "return" and (kind := _number_kind(hint)) is not None}
+    return _DECLARED[cls]
+
+
+def as_declared(value: Any, kind: NumberKind) -> Any:
+    """``value`` with its numbers (inside lists, tuples and arrays too) written as ``kind`` says.
+
+    A float field stores a float and an int field an int, so that equal values give one key:
+    ``1`` and ``1.0``, ``0.0`` and ``-0.0``, ``100`` and ``100.0`` where an int is declared. A
+    number an int field holds that is not a whole number is kept as it is (the class's own
+    check refuses it).
+    """
+    if kind is None or value is None or isinstance(value, bool | str):
+        return value
+    if isinstance(value, np.ndarray):
+        return as_declared(value.tolist(), kind)
+    if isinstance(value, list | tuple):
+        return [as_declared(v, kind) for v in value]
+    if isinstance(value, int | float | np.integer | np.floating):
+        if kind == "float":
+            return float(value) + 0.0  # + 0.0 turns -0.0 into 0.0
+        if float(value).is_integer():
+            return int(value)
+    return value
+
+
 def to_dict(value: Any, exact: bool = True) -> Any:
     """``value`` as canonical JSON data: numbers, strings, lists and dicts.
 
     A dataclass (an option object, a task) becomes ``{"type": ..., field: value, ...}`` with
     every constructor field; a value with a ``definition()`` method becomes ``{"type": ...,
     **definition()}``; arrays and tuples become lists; a function becomes its
-    :func:`function_name`.
+    :func:`function_name`. A field's numbers are written as its declared type says
+    (:func:`declared_numbers`, :func:`as_declared`): equal values give equal data.
 
     Parameters
     ----------
@@ -137,7 +229,9 @@ def to_dict(value: Any, exact: bool = True) -> Any:
         else:
             raise UnnamedError(f"{value!r} is neither a dataclass nor defines definition(): a stored run "
                                f"cannot name it")
-        return {"type": _type_name(type(value)), **{k: to_dict(v, exact) for k, v in fields.items()}}
+        kinds = declared_numbers(type(value))
+        return {"type": _type_name(type(value)),
+                **{k: to_dict(as_declared(v, kinds.get(k)), exact) for k, v in fields.items()}}
     except UnnamedError:
         if exact:
             raise
@@ -180,10 +274,11 @@ def run_definition(task: Any, method: Adaptive | Vanilla, theta0: Any, sigma: fl
     ``theta0`` is then None: the start comes from that run).
     """
     return {"task": to_dict(task, exact), "method": to_dict(method, exact),
-            "theta0": None if warm_start is not None else to_dict(np.ravel(np.asarray(theta0, dtype=float)), exact),
-            "sigma": to_dict(sigma, exact), "budget": int(budget), "stop_on_divergence": bool(stop_on_divergence),
+            "theta0": None if warm_start is not None else to_dict(as_declared(np.ravel(theta0), "float"), exact),
+            "sigma": to_dict(as_declared(sigma, "float"), exact), "budget": int(budget),
+            "stop_on_divergence": bool(stop_on_divergence),
             "warm_start": warm_start}
 
 
-__all__ = ["OPTION_TYPES", "TASK_TYPES", "UnnamedError", "from_dict", "function_name", "import_name", "run_definition",
-           "to_dict"]
+__all__ = ["NumberKind", "OPTION_TYPES", "TASK_TYPES", "UnnamedError", "as_declared", "declared_numbers", "from_dict",
+           "function_name", "import_name", "run_definition", "to_dict"]

@@ -1,8 +1,11 @@
 r"""Learning loops of Chapter 5: Algorithm 4.1 (adaptive step and batch size) and
 vanilla policy gradient with a fixed batch size.
 
-Both return a :class:`LearningRecord` of per-iteration arrays. Iteration i collects
-``batch_size[i]`` trajectories with the policy ``theta[i]`` and moves to ``theta[i+1]``.
+:func:`learn` runs either method (an :class:`~safepg.options.Adaptive` or a
+:class:`~safepg.options.Vanilla`); :func:`adaptive_pg` and :func:`vanilla_pg` build the method
+from their options and call it. Each returns a :class:`~safepg.record.LearningRecord` of
+per-iteration arrays. Iteration i collects ``batch_size[i]`` trajectories with the policy
+``theta[i]`` and moves to ``theta[i+1]``.
 """
 
 from __future__ import annotations
@@ -19,13 +22,7 @@ from safepg.bounds import ErrorBound, error_bound
 from safepg.constants import TaskConstants
 from safepg.definition import run_definition
 from safepg.estimators import gradient_samples
-from safepg.meta import (
-    coordinate_step,
-    guaranteed_improvement,
-    optimal_batch_size,
-    penalty_constant,
-    scalar_step,
-)
+from safepg.meta import coordinate_step, optimal_batch_size, penalty_constant, scalar_step
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
 from safepg.record import CHECKPOINTS, LearningRecord, RecordFileError
@@ -267,6 +264,149 @@ def _initial_policy(hooks: Hooks, theta0: np.ndarray | float, sigma: float | np.
     return LinearGaussianPolicy(theta0, sigma)
 
 
+def _adaptive_rule(method: Adaptive, constants: TaskConstants, c_bounds: float) -> _UpdateRule:
+    """Algorithm 4.1's update with ``method``'s options.
+
+    Parameters
+    ----------
+    method : Adaptive
+        The bound, the batch-size limits and the departures the update follows.
+    constants : TaskConstants
+        The task's bound constants at the policy's sigma.
+    c_bounds : float
+        The penalty constant of ``constants``.
+
+    Returns
+    -------
+    callable
+        The rule :func:`_learn` applies to each batch: Corollary 4.2.8's step on the largest
+        gradient component and the next batch size N* (Theorem 4.3.2) in [n_min, n_max].
+    """
+    gradient, error, batches, departures = method.gradient, method.error, method.batches, method.departures
+
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
+        k = int(np.argmax(np.abs(grad)))
+        g = float(abs(grad[k]))
+        batch_constants, c = constants, c_bounds
+        if found is not None:  # departures.batch_constants: this batch's R and M_phi
+            batch_constants = replace(constants, R=found[0], M_phi=found[1])
+            c = penalty_constant(batch_constants)
+        spread = {}
+        if departures.maxima:
+            spread = dict(variance=float(np.var(samples, axis=0, ddof=1).max()),
+                          sample_range=float(np.ptp(samples, axis=0).max()))
+        eb: ErrorBound = error_bound(error.bound, samples[:, k], error.delta, batch_constants, gradient.estimator,
+                                     error.range, **spread)
+        eps = float(eb.eps(n))
+        alpha = coordinate_step(g, eps, c, guarded=not departures.unguarded_step)
+        step = np.zeros_like(grad)
+        step[k] = alpha * grad[k]
+        return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, batches.n_min, batches.n_max))
+
+    return rule
+
+
+def _vanilla_rule(method: Vanilla, constants: TaskConstants, c: float) -> _UpdateRule:
+    """The update of policy gradient with ``method``'s fixed batch size and step.
+
+    Parameters
+    ----------
+    method : Vanilla
+        The batch size, the step and the estimator.
+    constants : TaskConstants
+        The task's bound constants at the policy's sigma (a :class:`~safepg.options.SafeStep`'s bound).
+    c : float
+        The penalty constant of ``constants``.
+
+    Returns
+    -------
+    callable
+        The rule :func:`_learn` applies to each batch: a fixed step, or the safe step of
+        Pirotta et al. (2013) / Corollary 4.2.8 with one eps for all components.
+    """
+    batch_size, step, gradient = method.batch_size, method.step, method.gradient
+
+    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
+        k = int(np.argmax(np.abs(grad)))
+        if isinstance(step, FixedStep):
+            eps, safe, a = 0.0, True, step.alpha
+        else:
+            e = step.error
+            # One common eps for all components: the largest per-component bound.
+            eps = max(float(error_bound(e.bound, samples[:, i], e.delta, constants, gradient.estimator,
+                                        e.range).eps(n)) for i in range(grad.size))
+            safe = eps < abs(grad[k])
+            a = scalar_step(grad, eps, c) if step.kind == "scalar" else coordinate_step(abs(grad[k]), eps, c)
+        if step.kind == "scalar":
+            return _Update(a * grad, a, -1, eps, safe, batch_size)
+        d = np.zeros_like(grad)
+        d[k] = a * grad[k]
+        return _Update(d, a, k, eps, safe, batch_size)
+
+    return rule
+
+
+def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
+          budget: int, rng: RNGLike = None, progress: Progress = False,
+          stop_on_divergence: bool = False) -> LearningRecord:
+    """Run ``method`` on ``task``: Algorithm 4.1 for an :class:`~safepg.options.Adaptive`
+    (:func:`adaptive_pg`), policy gradient with a fixed batch size for a
+    :class:`~safepg.options.Vanilla` (:func:`vanilla_pg`).
+
+    Both loops are this function: :func:`adaptive_pg` and :func:`vanilla_pg` build the method
+    from their options and call it, so a method gives the same record however it is run. Both
+    have the same divergence behaviour: raise ``ValueError``, or with ``stop_on_divergence``
+    end the run with ``diverged`` set (a campaign's runs do: :class:`safepg.runner.RunConfig`).
+
+    Parameters
+    ----------
+    task : Task
+        As in :func:`adaptive_pg`.
+    method : Adaptive or Vanilla
+        The method with all its options.
+    theta0, sigma, budget, rng, progress, stop_on_divergence
+        As in :func:`adaptive_pg`.
+
+    Returns
+    -------
+    LearningRecord
+        The per-iteration arrays; ``config`` holds the run's definition
+        (:func:`safepg.definition.run_definition`) and ``config["c"]``, the penalty constant
+        from the task's bounds.
+
+    Raises
+    ------
+    TypeError
+        ``method`` is neither an Adaptive nor a Vanilla, or the task's declared fast paths
+        are malformed (:func:`safepg.tasks.task_hooks`).
+    ValueError
+        A bad ``budget``, ``theta0`` or ``sigma``, or (without ``stop_on_divergence``) a
+        gradient estimate that is not finite.
+    """
+    # The method's type first: the budget is checked against its first batch.
+    if isinstance(method, Adaptive):
+        first = method.batches.first_size
+    elif isinstance(method, Vanilla):
+        first = method.batch_size
+    else:
+        raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
+    _check_budget(budget, first)
+    hooks = task_hooks(task)
+    policy = _initial_policy(hooks, theta0, sigma)
+    constants = TaskConstants.from_task(task, policy.sigma)
+    c = penalty_constant(constants)
+    config = {**run_definition(task, method, theta0, sigma, budget, stop_on_divergence, exact=False), "c": c}
+    if isinstance(method, Adaptive):
+        return _learn(task, hooks, policy, _adaptive_rule(method, constants, c), first, budget, rng, method.gradient,
+                      config, progress, stop_on_divergence, batch_constants=method.departures.batch_constants)
+    # A callable progress is called after each batch: only the Python loop stops there.
+    fused = isinstance(method.step, FixedStep) and method.target is None and not callable(progress)
+    if fused and hooks.fixed_step_batches is not None:
+        return _learn_fixed_step(hooks, policy, method, budget, rng, config, bool(progress), stop_on_divergence)
+    return _learn(task, hooks, policy, _vanilla_rule(method, constants, c), first, budget, rng, method.gradient,
+                  config, progress, stop_on_divergence, method.target)
+
+
 def adaptive_pg(
     task: Task,
     theta0: np.ndarray | float = 0.0,
@@ -289,6 +429,9 @@ def adaptive_pg(
     moves :math:`\theta_k` by the step of Corollary 4.2.8, and sets the next batch size to
     N* (Theorem 4.3.2, or the search of Section 4.3.3 for Bernstein) clipped to
     [n_min, n_max]. The first batch has n_min trajectories (``batches.first`` to change it).
+
+    The same run as ``learn(task, Adaptive(gradient, error, batches, departures), theta0, sigma,
+    ...)``, which this function calls (:func:`learn`).
 
     Parameters
     ----------
@@ -328,36 +471,9 @@ def adaptive_pg(
         (:func:`safepg.definition.run_definition`) and ``config["c"]``, the penalty constant
         from the task's bounds.
     """
-    method = Adaptive(gradient, error, batches, departures)  # checks each option's type
-    first = batches.first_size
-    _check_budget(budget, first)
-    hooks = task_hooks(task)
-    policy = _initial_policy(hooks, theta0, sigma)
-    constants = TaskConstants.from_task(task, policy.sigma)
-    c_bounds = penalty_constant(constants)
-
-    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
-        k = int(np.argmax(np.abs(grad)))
-        g = float(abs(grad[k]))
-        batch_constants, c = constants, c_bounds
-        if found is not None:  # departures.batch_constants: this batch's R and M_phi
-            batch_constants = replace(constants, R=found[0], M_phi=found[1])
-            c = penalty_constant(batch_constants)
-        spread = {}
-        if departures.maxima:
-            spread = dict(variance=float(np.var(samples, axis=0, ddof=1).max()),
-                          sample_range=float(np.ptp(samples, axis=0).max()))
-        eb: ErrorBound = error_bound(error.bound, samples[:, k], error.delta, batch_constants, gradient.estimator,
-                                     error.range, **spread)
-        eps = float(eb.eps(n))
-        alpha = coordinate_step(g, eps, c, guarded=not departures.unguarded_step)
-        step = np.zeros_like(grad)
-        step[k] = alpha * grad[k]
-        return _Update(step, alpha, k, eps, eps < g, optimal_batch_size(g, eb, c, batches.n_min, batches.n_max))
-
-    config = {**run_definition(task, method, theta0, sigma, budget, stop_on_divergence, exact=False), "c": c_bounds}
-    return _learn(task, hooks, policy, rule, first, budget, rng, gradient, config, progress, stop_on_divergence,
-                  batch_constants=departures.batch_constants)
+    # Building the method checks each option's type, before anything else is looked at.
+    return learn(task, Adaptive(gradient, error, batches, departures), theta0, sigma, budget=budget, rng=rng,
+                 progress=progress, stop_on_divergence=stop_on_divergence)
 
 
 def vanilla_pg(
@@ -388,6 +504,9 @@ def vanilla_pg(
     A fixed step without a target runs in the task's compiled loop when it has one
     (:class:`~safepg.tasks.FixedStepBatches`, as the LQG does), with the same numbers; a
     callable ``progress``, which is called after every batch, keeps the loop in Python.
+
+    The same run as ``learn(task, Vanilla(batch_size, step, gradient, target), theta0, sigma,
+    ...)``, which this function calls (:func:`learn`).
 
     Parameters
     ----------
@@ -421,70 +540,13 @@ def vanilla_pg(
     LearningRecord
         The per-iteration arrays and the settings in ``config``.
     """
-    method = Vanilla(batch_size, step, gradient, target)  # checks batch_size and each option's type
-    _check_budget(budget, batch_size)
-    hooks = task_hooks(task)
-    policy = _initial_policy(hooks, theta0, sigma)
-    constants = TaskConstants.from_task(task, policy.sigma)
-    c = penalty_constant(constants)
-
-    def rule(samples: np.ndarray, grad: np.ndarray, n: int, found: tuple[float, float] | None) -> _Update:
-        k = int(np.argmax(np.abs(grad)))
-        if isinstance(step, FixedStep):
-            eps, safe, a = 0.0, True, step.alpha
-        else:
-            e = step.error
-            # One common eps for all components: the largest per-component bound.
-            eps = max(float(error_bound(e.bound, samples[:, i], e.delta, constants, gradient.estimator,
-                                        e.range).eps(n)) for i in range(grad.size))
-            safe = eps < abs(grad[k])
-            a = scalar_step(grad, eps, c) if step.kind == "scalar" else coordinate_step(abs(grad[k]), eps, c)
-        if step.kind == "scalar":
-            return _Update(a * grad, a, -1, eps, safe, batch_size)
-        d = np.zeros_like(grad)
-        d[k] = a * grad[k]
-        return _Update(d, a, k, eps, safe, batch_size)
-
-    config = {**run_definition(task, method, theta0, sigma, budget, stop_on_divergence, exact=False), "c": c}
-    # A callable progress is called after each batch: only the Python loop stops there.
-    fused = isinstance(step, FixedStep) and target is None and not callable(progress)
-    if fused and hooks.fixed_step_batches is not None:
-        return _learn_fixed_step(hooks, policy, method, budget, rng, config, bool(progress), stop_on_divergence)
-    return _learn(task, hooks, policy, rule, batch_size, budget, rng, gradient, config, progress,
-                  stop_on_divergence, target)
+    # Building the method checks batch_size and each option's type, before anything else is looked at.
+    return learn(task, Vanilla(batch_size, step, gradient, target), theta0, sigma, budget=budget, rng=rng,
+                 progress=progress, stop_on_divergence=stop_on_divergence)
 
 
-def learn(task: Task, method: Adaptive | Vanilla, theta0: np.ndarray | float = 0.0, sigma: float = 1.0, *,
-          budget: int, rng: RNGLike = None, progress: Progress = False,
-          stop_on_divergence: bool = False) -> LearningRecord:
-    """Run ``method`` on ``task``: :func:`adaptive_pg` for an :class:`~safepg.options.Adaptive`,
-    :func:`vanilla_pg` for a :class:`~safepg.options.Vanilla`, with the same divergence
-    behaviour for both: raise ``ValueError``, or with ``stop_on_divergence`` end the run
-    with ``diverged`` set (a campaign's runs do: :class:`safepg.runner.RunConfig`).
-
-    Parameters
-    ----------
-    task : Task
-        As in :func:`adaptive_pg`.
-    method : Adaptive or Vanilla
-        The method with all its options.
-    theta0, sigma, budget, rng, progress, stop_on_divergence
-        As in :func:`adaptive_pg`.
-
-    Returns
-    -------
-    LearningRecord
-    """
-    if isinstance(method, Adaptive):
-        return adaptive_pg(task, theta0, sigma, gradient=method.gradient, error=method.error,
-                           batches=method.batches, departures=method.departures, budget=budget, rng=rng,
-                           progress=progress, stop_on_divergence=stop_on_divergence)
-    if isinstance(method, Vanilla):
-        return vanilla_pg(task, theta0, sigma, batch_size=method.batch_size, step=method.step,
-                          gradient=method.gradient, target=method.target, budget=budget, rng=rng, progress=progress,
-                          stop_on_divergence=stop_on_divergence)
-    raise TypeError(f"method must be an Adaptive or a Vanilla, got {method!r}")
-
-
+# CHECKPOINTS, LearningRecord and RecordFileError live in safepg.record, where the library imports
+# them from; they stay exported here too because the API page documents them under safepg.learning,
+# and code written against that page imports them from this module.
 __all__ = ["CHECKPOINTS", "FUSED_TRAJECTORIES", "LearningRecord", "Progress", "RecordFileError", "adaptive_pg",
-           "guaranteed_improvement", "learn", "vanilla_pg"]
+           "learn", "vanilla_pg"]

@@ -28,7 +28,7 @@ def penalty_constant(constants: TaskConstants) -> float:
     .. math:: c = \frac{R M_\phi^2}{(1-\gamma)^2\sigma^2}
               \Big(\frac{|\mathcal A|}{\sqrt{2\pi}\,\sigma} + \frac{\gamma}{2(1-\gamma)}\Big)
     """
-    R, M, A, gamma, s = constants.R, constants.M_phi, constants.A_volume, constants.gamma, constants.sigma
+    R, M, A, gamma, s = constants.R, constants.M_phi, constants.action_volume, constants.gamma, constants.sigma
     if constants.horizon_term != "effective":
         # The same constant with 1 / (1 - gamma) replaced by the horizon factor h
         # (TaskConstants.horizon_term): c = R M^2 h^2 / sigma^2 (|A| / (sqrt(2 pi) sigma) + gamma h / 2).

@@ -20,6 +20,7 @@ Every object checks its own values when it is built, with a message naming the f
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Literal, NamedTuple
 
@@ -41,7 +42,8 @@ def _check_flag(name: str, value: object) -> None:
 
 
 def _check_size(name: str, value: object, low: int = 2) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | float) or int(value) != value or value < low:
+    # numbers.Real: NumPy's integers too (a size read off an array), which int | float does not admit.
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not float(value).is_integer() or value < low:
         raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
 
 

@@ -21,6 +21,8 @@ from safepg import portable
 
 #: Trajectory counts at which Figures 5.1-5.2 are read off (``LearningRecord.J_at``).
 CHECKPOINTS = (100_000, 1_000_000, 3_000_000, 10_000_000, 30_000_000)
+#: A run's performance: the closed-form ``"J"`` or the measured ``"J_hat"``.
+Performance = Literal["J", "J_hat"]
 
 
 class RecordFileError(ValueError):
@@ -124,14 +126,21 @@ class LearningRecord:
         # Exact sums (math.fsum), not ``@``: BLAS's dot product differs across CPUs in the last bit.
         return portable.fsum_mean(self.J_hat, weights=self.batch_size)
 
-    def improvement_ratio(self, on: Literal["J", "J_hat"] = "J") -> float:
+    @property
+    def performance_field(self) -> Performance:
+        """The performance this run is judged on by default: ``"J"`` where the task has a closed
+        form (J is not NaN), else ``"J_hat"``, the measured returns (every task has them)."""
+        return "J" if not np.isnan(self.J).all() else "J_hat"
+
+    def improvement_ratio(self, on: Performance | None = None) -> float:
         """Share of policy updates after which performance did not decrease.
 
         ``on="J"``: the closed-form J (Section 5.1); ``on="J_hat"``: the batch-average
-        return of consecutive batches (Section 5.3, no closed form). NaN where the performance
-        is unknown (``J`` of a task without a closed form, which is NaN) or nothing was updated.
+        return of consecutive batches (Section 5.3, no closed form); None:
+        :attr:`performance_field`. NaN where the performance is unknown (``J`` of a task
+        without a closed form, which is NaN) or nothing was updated.
         """
-        perf = self.J if on == "J" else self.J_hat
+        perf = getattr(self, on or self.performance_field)
         if np.isnan(perf).any():
             return float("nan")
         with np.errstate(invalid="ignore"):  # -inf to -inf (a diverged run) counts as no improvement
@@ -140,29 +149,57 @@ class LearningRecord:
             return float("nan")
         return float(np.mean(steps >= 0))
 
-    def J_at(self, checkpoints: tuple[int, ...] = CHECKPOINTS) -> dict[str, float]:
-        """J of the policy that generated trajectory number T (1-based), for each
-        reached checkpoint T: Figures 5.1-5.2 read at T."""
+    def checkpoints(self, count: int = 4) -> tuple[int, ...]:
+        """The run's own checkpoints: ``count`` trajectory counts evenly spread up to its last
+        trajectory (by default a quarter, half, three quarters and all of it)."""
+        return tuple(sorted({max(1, self.trajectories * (i + 1) // count) for i in range(count)}))
+
+    def at(self, checkpoints: Sequence[int] | None = None, field: Performance | None = None) -> dict[str, float]:
+        """``field`` (default :attr:`performance_field`) at each reached checkpoint T (1-based):
+        J of the policy that generated trajectory T, or the measured return of the batch that
+        holds it. ``checkpoints`` default to the run's own (:meth:`checkpoints`)."""
+        field = field or self.performance_field
+        values = getattr(self, field)
         ends = np.cumsum(self.batch_size)
         out = {}
-        for T in checkpoints:
+        for T in self.checkpoints() if checkpoints is None else checkpoints:
             if T <= self.trajectories:
-                out[str(T)] = float(self.J[int(np.searchsorted(ends, T))])
+                out[str(T)] = float(values[int(np.searchsorted(ends, T))])
         return out
 
-    def performance_curve(self) -> tuple[np.ndarray, np.ndarray]:
-        """(trajectories used so far, J) as a step curve, Figures 5.1-5.2."""
-        return np.concatenate([[0], np.cumsum(self.batch_size)]), self.J
+    def J_at(self, checkpoints: Sequence[int] | None = None) -> dict[str, float]:
+        """J of the policy that generated trajectory number T (1-based), for each reached
+        checkpoint T: Figures 5.1-5.2 read at T (the thesis's are ``CHECKPOINTS``; by
+        default the run's own, :meth:`checkpoints`)."""
+        return self.at(checkpoints, "J")
 
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready summary of the run."""
+    def performance_curve(self, field: Performance | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(trajectories used before each value, the value) as a step curve, Figures 5.1-5.2.
+
+        ``"J"`` (the default where there is a closed form) is J before each batch and after the
+        last, at 0, N_1, N_1 + N_2, ...; ``"J_hat"`` is each batch's measured return, at its start.
+        """
+        field = field or self.performance_field
+        ends = np.concatenate([[0], np.cumsum(self.batch_size)])
+        return (ends, self.J) if field == "J" else (ends[:-1], self.J_hat)
+
+    def summary(self, checkpoints: Sequence[int] | None = None) -> dict[str, Any]:
+        """JSON-ready summary of the run (``checkpoints``: as :meth:`at`, the run's own by default).
+
+        ``J_*`` read the closed form (NaN without one); ``performance`` reads
+        :attr:`performance_field`, which every task has.
+        """
+        field = self.performance_field
+        values = getattr(self, field)
         return {
             "iterations": self.iterations,
             "trajectories": self.trajectories,
             "theta": self.theta_final.tolist(),
             "J_initial": float(self.J[0]),
             "J_final": float(self.J[-1]),
-            "J_at": self.J_at(),
+            "J_at": self.J_at(checkpoints),
+            "performance": {"field": field, "initial": float(values[0]), "final": float(values[-1]),
+                            "at": self.at(checkpoints, field)},
             "upsilon_bar": self.upsilon_bar(),
             "improvement_ratio": self.improvement_ratio(),
             "batch_sizes": self.batch_size.tolist(),
@@ -243,14 +280,15 @@ class LearningRecord:
             raise RecordFileError(path, f"arrays that do not form one run ({err})") from err
         return rec
 def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequence[int],
-                    field: Literal["J", "J_hat"] = "J") -> np.ndarray:
+                    field: Performance | None = None) -> np.ndarray:
     """Several seeds' runs on one axis of trajectories: per run, ``field`` of the iteration whose
     batch holds trajectory T, for each T of ``grid`` (1-based).
 
     ``"J"`` is the thesis's "expected performance over sample trajectories" (Figures 5.1-5.2:
     each iteration's J held for all the trajectories of its batch); ``"J_hat"`` the batch's
     measured average return (Figure 5.9). Runs of different batch sizes thus line up, and
-    their mean or band over seeds can be taken column by column.
+    their mean or band over seeds can be taken column by column. None: the first record's
+    :attr:`~LearningRecord.performance_field`.
 
     Returns
     -------
@@ -258,6 +296,7 @@ def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequen
         NaN past a run's last trajectory.
     """
     grid = np.asarray(grid)
+    field = field or (records[0].performance_field if records else "J")
     out = np.full((len(records), grid.size), np.nan)
     for i, r in enumerate(records):
         idx = np.searchsorted(np.cumsum(r.batch_size), grid)
@@ -266,4 +305,4 @@ def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequen
     return out
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "RecordFileError", "on_trajectories"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "Performance", "RecordFileError", "on_trajectories"]

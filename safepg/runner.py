@@ -8,9 +8,10 @@ configuration and seed give the same numbers on any machine and in any order.
 :func:`run_configs` executes the missing (config, seed) runs of a group of configurations
 through joblib (all cores by default; a user with a cluster wraps the call in
 ``joblib.parallel_config(backend="dask")`` or ``"ray"`` without code changes), shows tqdm
-progress, and writes each finished run atomically to ``<folder>/<config>/seed-<k>.npz``
-(:mod:`safepg.store`). An interrupted campaign resumes where it stopped; a run whose
-settings or library version changed is recomputed, the others are not. A damaged run file
+progress, and writes each finished run atomically to ``<folder>/<config>/<key>/seed-<k>.npz``
+(:func:`run_path`, :mod:`safepg.store`). An interrupted campaign resumes where it stopped; a
+run whose settings or library version changed is computed into its own key's folder, beside
+the old runs, which :func:`prune` removes when no configuration asks for them. A damaged run file
 (truncated, overwritten) is set aside, named in a warning, and its run computed again
 (:mod:`safepg.store`).
 
@@ -25,9 +26,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import time
-from collections.abc import Mapping, Sequence
-from dataclasses import KW_ONLY, dataclass, field, replace
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import KW_ONLY, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
@@ -35,8 +37,9 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from safepg.definition import from_dict, run_definition
-from safepg.learning import LearningRecord, learn
+from safepg.learning import learn
 from safepg.options import Adaptive, Method, Vanilla
+from safepg.record import LearningRecord, RecordFileError
 from safepg.store import DamagedRunsError, OnDamaged, load_stored, remove_stale_temp_files, save_atomic
 
 #: Bump when a change to the library alters the numbers a run produces; stored runs with
@@ -105,6 +108,10 @@ class RunConfig:
             raise TypeError(f"method must be an Adaptive or a Vanilla, got {self.method!r}")
         if isinstance(self.task, str):
             make_env(self.task)  # an unknown name fails here, not in a worker
+        if isinstance(self.budget, bool) or not isinstance(self.budget, int | float | np.integer | np.floating) \
+                or not float(self.budget).is_integer() or self.budget < 1:
+            raise ValueError(f"budget must be a whole number of trajectories >= 1, got {self.budget!r}")
+        object.__setattr__(self, "budget", int(self.budget))
         object.__setattr__(self, "theta0", tuple(float(t) for t in np.ravel(self.theta0)))
 
     @property
@@ -177,7 +184,19 @@ class RunConfig:
 
 
 def run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
-    """Where seed ``seed`` of ``cfg`` is stored in a group's folder."""
+    """Where seed ``seed`` of ``cfg`` is stored in a group's folder: ``folder/<name>/<key>/seed-<seed>.npz``.
+
+    The definition's :meth:`~RunConfig.key` is part of the path, so a run of a changed
+    definition is stored beside the runs of the old one, never over them (:func:`prune` removes
+    the runs no configuration asks for any longer). Before version 0.5 the path was
+    ``folder/<name>/seed-<seed>.npz`` (:func:`legacy_run_path`): such files are still read when
+    their key matches, and never written.
+    """
+    return Path(folder) / cfg.name / cfg.key() / f"seed-{seed}.npz"
+
+
+def legacy_run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
+    """Where seed ``seed`` of ``cfg`` was stored before the key was part of the path (read, never written)."""
     return Path(folder) / cfg.name / f"seed-{seed}.npz"
 
 
@@ -185,9 +204,19 @@ def stored_run(folder: str | os.PathLike[str], cfg: RunConfig, seed: int,
                on_damaged: OnDamaged = "warn") -> LearningRecord | None:
     """Seed ``seed`` of ``cfg`` from the store, or ``None`` if it is not there (or was made otherwise).
 
-    A damaged file is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
+    Looks at :func:`run_path`, then at :func:`legacy_run_path` (a folder written before the key
+    was part of the path), where only a run of this very definition is accepted. A damaged file
+    is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
     """
-    return load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
+    rec = load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
+    if rec is None and not run_path(folder, cfg, seed).exists():
+        rec = load_stored(legacy_run_path(folder, cfg, seed), cfg.key(), on_damaged)
+    return rec
+
+
+def is_stored(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> bool:
+    """Whether a file for seed ``seed`` of ``cfg`` is in the store (not read: it may still be damaged)."""
+    return run_path(folder, cfg, seed).exists() or legacy_run_path(folder, cfg, seed).exists()
 
 
 def store_run(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> None:
@@ -197,6 +226,22 @@ def store_run(rec: LearningRecord, folder: str | os.PathLike[str], cfg: RunConfi
     rec.config["config_name"] = cfg.name
     rec.config["seed"] = seed
     save_atomic(rec, run_path(folder, cfg, seed))
+
+
+def check_names(configs: Sequence[RunConfig]) -> None:
+    """Refuse two configurations of one name but different definitions (one folder, one name, one run).
+
+    Raises
+    ------
+    ValueError
+        Naming the name and both keys.
+    """
+    seen: dict[str, str] = {}
+    for c in configs:
+        key = c.key()
+        if seen.setdefault(c.name, key) != key:
+            raise ValueError(f"two configs are named {c.name!r} with different definitions (keys {seen[c.name]} "
+                             f"and {key}): give each its own name")
 
 
 def _compute(cfg: RunConfig, seed: int, theta0: np.ndarray | None, single_thread: bool) -> LearningRecord:
@@ -240,6 +285,7 @@ def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.Pa
     Damaged files are left out with a warning; with ``on_damaged="raise"``, every file is
     read first and one :class:`~safepg.store.DamagedRunsError` names all the damaged ones.
     """
+    check_names(configs)
     out: dict[str, list[LearningRecord]] = {}
     damaged = []
     for c in configs:
@@ -253,6 +299,61 @@ def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.Pa
     if damaged:
         raise DamagedRunsError(damaged)
     return out
+
+
+_RUN_FILE = re.compile(r"^seed-\d+\.npz$")
+_KEY_DIR = re.compile(r"^[0-9a-f]{16}$")
+
+
+def _legacy_key(path: Path) -> str | None:
+    """The key a run file of the old layout was stamped with, or None if it cannot be read (kept: damaged)."""
+    try:
+        return str(LearningRecord.load(path).config.get("run_key"))
+    except (RecordFileError, OSError):
+        return None
+
+
+def prune(folder: str | os.PathLike[str], configs: Sequence[RunConfig], dry_run: bool = False) -> list[Path]:
+    """Remove the runs in a group's ``folder`` of definitions that none of ``configs`` has; return them.
+
+    A run is kept when its name is one of ``configs``' and it was made by that config's
+    definition (its key; a name asked for with several definitions keeps each); every other
+    run file is removed: the runs of an older definition of
+    a config, and those of names no config has any longer. Only run files are touched
+    (``<name>/<key>/seed-<k>.npz``, and ``<name>/seed-<k>.npz`` of the old layout, read for its
+    key): damaged files set aside, temporary files and anything else in the folder stay, and so
+    does an old-layout file that cannot be read.
+
+    Parameters
+    ----------
+    folder
+        The group's folder (:func:`run_configs`'s ``folder``).
+    configs
+        The configurations whose runs are kept.
+    dry_run
+        Only list what would be removed.
+    """
+    asked: dict[str, set[str]] = {}
+    for c in configs:
+        asked.setdefault(c.name, set()).add(c.key())
+    removed: list[Path] = []
+    root = Path(folder)
+    for name_dir in sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else ():
+        keys = asked.get(name_dir.name, set())
+        for path in sorted(name_dir.iterdir()):
+            if path.is_dir() and _KEY_DIR.match(path.name) and path.name not in keys:
+                removed += sorted(p for p in path.iterdir() if _RUN_FILE.match(p.name))
+            elif path.is_file() and _RUN_FILE.match(path.name):
+                stamped = _legacy_key(path)
+                if stamped is not None and stamped not in keys:
+                    removed.append(path)
+    if not dry_run:
+        for path in removed:
+            path.unlink()
+        for key_dir in {p.parent for p in removed}:
+            if key_dir != root and not any(key_dir.iterdir()):
+                key_dir.rmdir()
+    return removed
 
 
 @dataclass(frozen=True)
@@ -289,6 +390,7 @@ def run_configs(
     progress: bool = True,
     desc: str | None = None,
     first_seed: int = 0,
+    on_computed: OnComputed | None = None,
 ) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) and return all records by config name.
 
@@ -307,7 +409,8 @@ def run_configs(
     seeds
         Number of seeds n: one for all configs, or a count by config name.
     folder
-        The group's folder in the store; seed k of config ``c`` is ``folder/c.name/seed-k.npz``.
+        The group's folder in the store; seed k of config ``c`` is ``folder/c.name/c.key()/seed-k.npz``
+        (:func:`run_path`).
     starts
         For each warm-started config (by name), its starting parameters seed by seed.
     jobs
@@ -316,19 +419,28 @@ def run_configs(
         tqdm progress bar and its label (default: the folder's name).
     first_seed
         The first seed's index (another draw of the same runs: seeds disjoint from 0, 1, ...).
+    on_computed
+        Called as ``on_computed(folder, seconds, runs, jobs)`` if runs were computed: how long
+        they took (the book's campaign records it in each folder's ``timing.jsonl``).
+        Nothing is written for it otherwise.
     """
     group = RunGroup(configs, seeds, Path(folder), starts or {}, first_seed)
-    return run_groups([group], jobs, progress, desc or Path(folder).name)[0]
+    return run_groups([group], jobs, progress, desc or Path(folder).name, on_computed)[0]
+
+
+#: ``on_computed(folder, seconds, runs, jobs)`` of :func:`run_groups`: a folder's share of the wall time.
+OnComputed = Callable[[Path, float, int, int], None]
 
 
 def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True,
-               desc: str | None = None) -> list[dict[str, list[LearningRecord]]]:
+               desc: str | None = None, on_computed: OnComputed | None = None) -> list[dict[str, list[LearningRecord]]]:
     """:func:`run_configs` for several folders at once: their missing runs in one dispatch.
 
     The runs of all the groups are dispatched longest first together, so that no worker waits
-    at the end of one group while another group has runs left. Each group's ``timing.jsonl``
-    gets its share of the dispatch's wall time, in proportion to its runs' time on the workers
-    (one group: the whole wall time). Returns each group's records by config name, in order.
+    at the end of one group while another group has runs left. With ``on_computed``, each
+    group that computed runs is reported with its share of the dispatch's wall time, in
+    proportion to its runs' time on the workers (one group: the whole wall time). Returns each
+    group's records by config name, in order.
     """
     from joblib import Parallel, delayed, effective_n_jobs
 
@@ -339,6 +451,8 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
             if c.warm_start is not None and len(g.starts.get(c.name, ())) < len(g.seed_range(c)):
                 raise ValueError(f"starts must give {len(g.seed_range(c))} starting points for the warm-started "
                                  f"config {c.name!r}")
+    for g in groups:
+        check_names(g.configs)
     todo: list[tuple[int, RunConfig, int]] = []
     for k, g in enumerate(groups):
         # Files a killed runner was writing; a live runner's are kept.
@@ -370,79 +484,12 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
         wall = time.perf_counter() - started
         for k, g in enumerate(groups):
             runs = sum(1 for kk, _, _ in todo if kk == k)
-            if runs:
+            if runs and on_computed is not None:
                 share = worked[k] / sum(worked) if sum(worked) > 0 else runs / len(todo)
-                record_timing(g.folder, wall * share, runs, n_jobs)
+                on_computed(g.folder, wall * share, runs, n_jobs)
     return [load_configs(g.configs, g.seeds, g.folder, first_seed=g.first_seed) for g in groups]
 
 
-def _shape(d: Any) -> Any:
-    """A definition's structure: its keys, strings and flags, and the length of its lists, not its numbers."""
-    if isinstance(d, Mapping):
-        return tuple((k, _shape(v)) for k, v in sorted(d.items()))
-    if isinstance(d, list | tuple):
-        return tuple(_shape(v) for v in d)
-    return d if d is None or isinstance(d, bool | str) else type(d).__name__
-
-
-def _first_batch(cfg: RunConfig) -> int:
-    return cfg.method.batch_size if isinstance(cfg.method, Vanilla) else cfg.method.batches.first_size
-
-
-def _short_runs(configs: Sequence[RunConfig]) -> int:
-    """Two batches of each config, on one thread, nothing kept: what compiles their kernels."""
-    import numba
-
-    numba.set_num_threads(1)
-    for c in configs:
-        replace(c, budget=2 * _first_batch(c)).run(0)
-    return len(configs)
-
-
-def compile_once(configs: Sequence[RunConfig], jobs: int = -1) -> int:
-    """Compile the numba kernels that ``configs`` run, each in one worker, before a campaign runs them.
-
-    Numba compiles a kernel in every process that calls it before it is in numba's cache
-    (``safepg/__pycache__``); on a cold cache, the workers of :func:`run_configs` all compile
-    the same kernels at once, and one core's work is wasted per extra worker. Here the configs
-    are grouped by task family (task type and dimension: the same kernels), and each family
-    compiles in one joblib worker, the families side by side: two batches of one config of
-    each distinct kind (the structure of its definition: its keys, strings and flags, not its
-    numbers). The kernels go to numba's cache; the campaign's workers then load them. Nothing
-    is stored, and no number of a campaign depends on it. Warm-started configs are left out
-    (they run their start run's kernels).
-
-    Returns the number of short runs made.
-    """
-    from joblib import Parallel, delayed, effective_n_jobs
-
-    families: dict[Any, dict[Any, RunConfig]] = {}
-    for c in configs:
-        if c.warm_start is not None:
-            continue
-        d = c.definition(exact=False)
-        family = (d["task"].get("type"), d["task"].get("dim"))
-        families.setdefault(family, {}).setdefault(_shape([d["task"], d["method"]]), c)
-    groups = sorted((list(f.values()) for f in families.values()), key=len, reverse=True)
-    n_jobs = min(effective_n_jobs(jobs), len(groups))
-    if n_jobs < 2:  # one family, or one worker: each kernel is compiled once anyway
-        return 0
-    return sum(Parallel(n_jobs=n_jobs)(delayed(_short_runs)(g) for g in groups))
-
-
-#: One line per call of :func:`run_configs` (or :func:`run_groups`) that computed runs in a folder:
-#: how long it took (its share of the call's wall time).
-TIMING_FILE = "timing.jsonl"
-
-
-def record_timing(folder: Path, seconds: float, runs: int, jobs: int) -> None:
-    """Append {seconds, runs, jobs, cores, version} to ``folder/timing.jsonl``
-    (benchmarks/bench_book.py sets these against the random-number floor)."""
-    line = json.dumps({"seconds": round(seconds, 3), "runs": runs, "jobs": jobs, "cores": os.cpu_count(),
-                       "results_version": RESULTS_VERSION})
-    with open(folder / TIMING_FILE, "a") as f:
-        f.write(line + "\n")
-
-
-__all__ = ["RESULTS_VERSION", "RunConfig", "RunGroup", "Seeds", "TIMING_FILE", "compile_once", "load_configs",
-           "make_env", "record_timing", "run_configs", "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]
+__all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "RunGroup", "Seeds", "check_names", "is_stored",
+           "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_groups", "run_path", "seeds_of",
+           "store_run", "stored_run"]

@@ -34,11 +34,11 @@ import numpy as np
 from safepg import portable
 from safepg.envs.cartpole import CartPole
 from safepg.envs.pendulum import Pendulum
-from safepg.learning import LearningRecord
 from safepg.options import Adaptive
 from safepg.policies import LinearGaussianPolicy
+from safepg.record import LearningRecord
 from safepg.runner import RunConfig
-from safepg.tasks import task_hooks
+from safepg.tasks import constants_settings, task_hooks
 
 
 def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
@@ -51,7 +51,7 @@ def theorem_assumptions(cfg: RunConfig) -> list[dict[str, Any]]:
     if not isinstance(method, Adaptive):
         raise ValueError(f"cfg must be an adaptive run, got algorithm={cfg.algorithm!r}")
     task = cfg.make_task()
-    simulated, written = task.gamma, getattr(task, "constants_gamma", None)
+    simulated, written = task.gamma, constants_settings(task).constants_gamma
     one_discount = written is None or written == simulated
     from_bounds, guarded, per_component = method.departures.assumptions()
     empirical = method.error.bound in ("bernstein", "hoeffding") and method.error.empirical_range

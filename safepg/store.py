@@ -13,7 +13,9 @@ arrays that do not fit together: :class:`!safepg.record.RecordFileError`) is *da
 A damaged file is never deleted: the readers leave it out with a warning, and a runner
 about to compute its run again sets it aside first (:func:`set_aside`), keeping it for
 inspection. A readable file of other settings or another ``RESULTS_VERSION`` is not
-damaged but *stale*: it is simply recomputed and overwritten, without a word.
+damaged but *stale*: it is not this run. The runner stores each definition's runs in a folder
+of its own key (:func:`safepg.runner.run_path`), so a stale run is never overwritten; it stays
+until :func:`safepg.runner.prune` removes it.
 
 The results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
 """

@@ -9,11 +9,17 @@ inheriting it:
 * :class:`FixedStepBatches`: whole runs of vanilla policy gradient with a fixed step;
 * :class:`MeasuredReturns`: the per-trajectory performance the loops record as J_hat;
 * :class:`Performance` / :class:`PerformanceBatch`: the closed-form J;
-* :class:`ActionDimension`: the number of action dimensions (else 1).
+* :class:`ActionDimension`: the number of action dimensions (else 1);
+* :class:`ConstantsSettings`: how the bound constants are written, ``horizon_term`` and
+  ``constants_gamma`` (else :data:`DEFAULT_CONSTANTS_SETTINGS`, Theorem 4.2.3 as printed in the
+  task's own discount).
 
 :func:`task_hooks` checks a task once, when a learning loop starts: a declared hook that is
-missing or has other parameters, or a method with a hook's name that is not declared, is a
-``TypeError`` (a misspelt hook would otherwise be skipped in silence).
+missing or has other parameters, or a method or setting with a hook's name that is not declared,
+is a ``TypeError`` (a misspelt hook would otherwise be skipped in silence, and a misspelt setting
+would silently change a bound). :func:`constants_settings` is the one reader of the settings
+(:meth:`safepg.constants.TaskConstants.from_task` and :mod:`safepg.safety` read them through it),
+with the same check.
 """
 
 from __future__ import annotations
@@ -21,14 +27,35 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Protocol, cast
+from typing import Any, NamedTuple, Protocol, cast
 
 import numpy as np
 
-from safepg.constants import BoundedTask
 from safepg.policies import LinearGaussianPolicy
 from safepg.rng import RNGLike
 from safepg.trajectories import Trajectories
+
+
+class BoundedTask(Protocol):
+    """A task's bounds of Assumption 4.2.1 and its horizon: read-only, as attributes or properties."""
+
+    @property
+    def reward_bound(self) -> float: ...
+
+    @property
+    def feature_bound(self) -> float: ...
+
+    @property
+    def action_volume(self) -> float: ...
+
+    @property
+    def action_bound(self) -> float: ...
+
+    @property
+    def gamma(self) -> float: ...
+
+    @property
+    def horizon(self) -> int: ...
 
 
 class Task(BoundedTask, Protocol):
@@ -45,6 +72,39 @@ class ActionDimension(Protocol):
 
     @property
     def action_dim(self) -> int: ...
+
+
+class ConstantsSettings(Protocol):
+    """How the bound constants of Chapter 4 are written for this task (the simulation is unchanged).
+
+    A task that declares it defines both, as class attributes, dataclass fields with a default
+    or properties (the Protocol's are read-only properties, so ``self.horizon_term = ...`` in an
+    ``__init__`` is refused: store it under another name behind a property); one that does not
+    gets :data:`DEFAULT_CONSTANTS_SETTINGS`.
+    """
+
+    @property
+    def horizon_term(self) -> str:
+        """The horizon factor h of the penalty constant: ``"effective"``, ``"truncated"`` or
+        ``"horizon"`` (:class:`~safepg.constants.TaskConstants`)."""
+        ...
+
+    @property
+    def constants_gamma(self) -> float | None:
+        """The discount the constants are written in; None: the task's ``gamma``."""
+        ...
+
+
+class ConstantsSettingValues(NamedTuple):
+    """A task's :class:`ConstantsSettings`, as :func:`constants_settings` reads them."""
+
+    horizon_term: str
+    constants_gamma: float | None
+
+
+#: The settings of a task that does not declare :class:`ConstantsSettings`: Theorem 4.2.3 as
+#: printed (h = 1 / (1 - gamma)), in the task's own discount.
+DEFAULT_CONSTANTS_SETTINGS = ConstantsSettingValues(horizon_term="effective", constants_gamma=None)
 
 
 class GradientBatch(Protocol):
@@ -106,6 +166,9 @@ class PerformanceBatch(Protocol):
 METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
                                  FixedStepBatches: "fixed_step_batches", MeasuredReturns: "measured_returns",
                                  Performance: "performance", PerformanceBatch: "performance_batch"}
+#: The optional values (attributes or properties), by the Protocol that declares them.
+VALUE_HOOKS: dict[type, tuple[str, ...]] = {ActionDimension: ("action_dim",),
+                                            ConstantsSettings: ("horizon_term", "constants_gamma")}
 
 
 @dataclass(frozen=True)
@@ -140,19 +203,63 @@ def _check_signature(cls: type, proto: type, name: str) -> None:
                         f"{proto.__name__} declares, got ({', '.join(names)})")
 
 
+_MISSING = object()
+
+
+def _check_values(task: object) -> None:
+    """Refuse a value hook defined without its Protocol, or a Protocol declared without all its values.
+
+    "Defined" is on the instance or its class, looked up statically (no property runs, and
+    what a ``__getattr__`` forwards is not the task's own, as for the methods); the
+    Protocol's own stub is not a definition.
+    """
+    cls = type(task)
+    for proto, names in VALUE_HOOKS.items():
+        declared = proto in cls.__mro__
+        for name in names:
+            found = inspect.getattr_static(task, name, _MISSING)
+            defined = found is not _MISSING and found is not proto.__dict__[name]
+            if declared and not defined:
+                raise TypeError(f"{cls.__name__} declares {proto.__name__} but does not define {name}")
+            if defined and not declared:
+                raise TypeError(f"{cls.__name__} defines {name} but does not declare safepg.tasks.{proto.__name__}: "
+                                f"inherit it so that it is read")
+
+
+def constants_settings(task: object) -> ConstantsSettingValues:
+    """How the bound constants are written for ``task``: its :class:`ConstantsSettings` if it
+    declares them, else :data:`DEFAULT_CONSTANTS_SETTINGS`.
+
+    The one reader of ``horizon_term`` and ``constants_gamma``; the values themselves are
+    checked where they are used (:class:`~safepg.constants.TaskConstants`).
+
+    Raises
+    ------
+    TypeError
+        The task defines ``horizon_term`` or ``constants_gamma`` without declaring
+        :class:`ConstantsSettings`, or declares it without defining both (a misspelt name).
+    """
+    _check_values(task)
+    if ConstantsSettings not in type(task).__mro__:
+        return DEFAULT_CONSTANTS_SETTINGS
+    declared = cast(ConstantsSettings, task)  # checked above: the class inherits it and defines both
+    return ConstantsSettingValues(declared.horizon_term, declared.constants_gamma)
+
+
 def task_hooks(task: Task) -> Hooks:
-    """Check ``task``'s declared fast paths and return them bound.
+    """Check ``task``'s declared fast paths and settings, and return the fast paths bound.
 
     Raises
     ------
     TypeError
         A declared hook is missing or takes other parameters than its Protocol, or the task
-        has a method named like a hook without declaring its Protocol.
+        has a method or value named like a hook without declaring its Protocol.
     """
     cls = type(task)
     for attr in ("simulate", "reward_bound", "feature_bound", "action_volume", "action_bound", "gamma", "horizon"):
         if not hasattr(task, attr):
             raise TypeError(f"task must have {attr!r} (safepg.tasks.Task), {cls.__name__} has not")
+    _check_values(task)
     found: dict[str, Any] = {}
     for proto, name in METHOD_HOOKS.items():
         declared = proto in cls.__mro__
@@ -173,5 +280,6 @@ def task_hooks(task: Task) -> Hooks:
     return Hooks(**{name: found.get(name) for name in METHOD_HOOKS.values()}, action_dim=int(action_dim))
 
 
-__all__ = ["METHOD_HOOKS", "ActionDimension", "FixedStepBatches", "GradientBatch", "GradientBatchConstants", "Hooks",
-           "MeasuredReturns", "Performance", "PerformanceBatch", "Task", "task_hooks"]
+__all__ = ["DEFAULT_CONSTANTS_SETTINGS", "METHOD_HOOKS", "VALUE_HOOKS", "ActionDimension", "BoundedTask",
+           "ConstantsSettingValues", "ConstantsSettings", "FixedStepBatches", "GradientBatch", "GradientBatchConstants",
+           "Hooks", "MeasuredReturns", "Performance", "PerformanceBatch", "Task", "constants_settings", "task_hooks"]

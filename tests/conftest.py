@@ -26,6 +26,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tarfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -96,6 +97,55 @@ def import_or_fail(module: str, requirements: str = "requirements.txt") -> Any:
     except ImportError:
         skip_or_fail(f"{module} is not installed: run `make setup setup-dev` (it is pinned in {requirements})",
                      allow_module_level=True)
+
+
+def extract_archive(tar: tarfile.TarFile, dest: str | os.PathLike[str]) -> None:
+    """Extract ``tar`` into ``dest`` as ``tar.extractall(dest, filter="data")`` does, on any Python 3.11.
+
+    The ``filter`` argument came with Python 3.11.4; Debian 12's python3 is 3.11.2. There each member is
+    checked as the data filter checks it, just before it is extracted (a symlink extracted earlier is
+    followed): a :class:`tarfile.TarError` refuses an absolute name (which the data filter would extract
+    under ``dest`` with its leading ``/`` stripped), a name or a link whose real path leaves ``dest``, an
+    absolute link, and anything but a regular file, a directory or a link (devices, pipes). Regular files
+    get the data filter's mode (no setuid/setgid/sticky, no write for group and others, owner rw) and
+    their mtime, folders the umask's mode; no owner is set.
+    """
+    if hasattr(tarfile, "data_filter"):
+        tar.extractall(dest, filter="data")
+        return
+    import inspect
+
+    root = os.path.realpath(dest)
+    os.makedirs(root, exist_ok=True)
+    # A tarfile that takes filters (this branch meets one only in its test) applies none: the checks below are it.
+    trusted = {"filter": "fully_trusted"} if "filter" in inspect.signature(tar.extract).parameters else {}
+
+    def inside(path: str) -> bool:
+        return os.path.commonpath([os.path.realpath(path), root]) == root
+
+    for member in tar.getmembers():
+        name = member.name
+        if name.startswith(("/", os.sep)) or os.path.isabs(name):
+            raise tarfile.TarError(f"{name!r}: absolute path")
+        if not inside(os.path.join(root, name)):
+            raise tarfile.TarError(f"{name!r} would be extracted outside {root}")
+        if not (member.isreg() or member.isdir() or member.issym() or member.islnk()):
+            raise tarfile.TarError(f"{name!r}: special file (device, pipe), refused")
+        if member.issym() or member.islnk():
+            if os.path.isabs(member.linkname):
+                raise tarfile.TarError(f"{name!r}: link to the absolute path {member.linkname!r}")
+            base = os.path.join(root, os.path.dirname(name)) if member.issym() else root
+            if not inside(os.path.join(base, member.linkname)):
+                raise tarfile.TarError(f"{name!r}: link to {member.linkname!r}, outside {root}")
+        path = os.path.join(root, name)
+        if member.isdir():  # the umask's mode, as the data filter gives (tarfile would make it 0o700)
+            os.makedirs(path, exist_ok=True)
+            continue
+        tar.extract(member, root, set_attrs=False, **trusted)
+        if member.isreg():
+            mode = member.mode & 0o755
+            os.chmod(path, (mode if mode & 0o100 else mode & ~0o111) | 0o600)
+            os.utime(path, (member.mtime, member.mtime))
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

@@ -24,6 +24,7 @@ from test_browser_live_ch5 import _book_explorer_values
 from test_dist import _needs_build_tools, _tool_env
 
 import safepg
+from conftest import extract_archive
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.browser
@@ -69,7 +70,7 @@ def test_unpacked_site_works_from_disk(browser, book, tmp_path):
                           text=True, env=_tool_env())
     assert proc.returncode == 0, proc.stderr[-3000:]
     with tarfile.open(out / f"safepg-book-{safepg.__version__}.tar.gz") as tar:
-        tar.extractall(tmp_path / "site", filter="data")
+        extract_archive(tar, tmp_path / "site")
     site = tmp_path / "site" / f"safepg-book-{safepg.__version__}"
     assert not site.is_relative_to(ROOT)
 

@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from safepg.runner import TIMING_FILE
+from safepg.runner import run_configs
 from safepg.thesis import budget
+from safepg.thesis.campaign import TIMING_FILE
 from safepg.thesis.experiment_store import experiment_folder, run_experiment
 from safepg.thesis.experiments import get_experiment, scaled
 
@@ -22,7 +23,7 @@ def store(tmp_path_factory):
     lqg = scaled(get_experiment("table-5.3"), seeds=2, budget=3000)
     cart = scaled(get_experiment("cartpole-baseline"), seeds=1, budget=8000)
     for exp in (lqg, cart):
-        run_experiment(exp, root=root, jobs=1, progress=False)
+        run_experiment(exp, root=root, jobs=1, progress=False, timing=True)  # as run-book computes them
     return root, lqg, cart
 
 
@@ -35,8 +36,29 @@ def test_lqg_counts_follow_from_the_configs(store, monkeypatch):
     lines = (experiment_folder(lqg, root) / TIMING_FILE).read_text().splitlines()
     assert len(lines) == 1 and json.loads(lines[0])["runs"] == len(lqg.configs) * lqg.seeds
     assert w.seconds == pytest.approx(json.loads(lines[0])["seconds"]) and w.seconds > 0
-    run_experiment(lqg, root=root, jobs=1, progress=False)  # nothing left to compute: no new line
+    run_experiment(lqg, root=root, jobs=1, progress=False, timing=True)  # nothing left to compute: no new line
     assert len((experiment_folder(lqg, root) / TIMING_FILE).read_text().splitlines()) == 1
+
+
+def test_timing_is_written_only_when_asked(tmp_path, monkeypatch):
+    """The runner and the library write no timing file; run-book's ``timing=True`` does, once per
+    folder that computed runs (and none where the runs were stored)."""
+    exp = scaled(get_experiment("table-5.3"), seeds=1, budget=2000)
+    run_configs(exp.configs, 1, tmp_path / "runner", jobs=1, progress=False)
+    run_experiment(exp, root=tmp_path / "library", jobs=1, progress=False)
+    for folder in ("runner", "library"):
+        assert len(list((tmp_path / folder).rglob("*.npz"))) == len(exp.configs)
+        assert not list((tmp_path / folder).rglob(TIMING_FILE)), folder
+    monkeypatch.setattr(budget, "get_experiment", lambda name: exp)
+    assert budget.experiment_work(exp.name, "lqg2d", tmp_path / "library").seconds is None
+    run_experiment(exp, root=tmp_path / "library", jobs=1, progress=False, timing=True)  # all stored: no time
+    assert not list((tmp_path / "library").rglob(TIMING_FILE))
+
+    run_experiment(exp, root=tmp_path / "book", jobs=1, progress=False, timing=True)
+    assert [p.relative_to(tmp_path) for p in tmp_path.rglob(TIMING_FILE)] == [Path("book", exp.name, TIMING_FILE)]
+    line = json.loads((experiment_folder(exp, tmp_path / "book") / TIMING_FILE).read_text())
+    assert line["runs"] == len(exp.configs) and line["seconds"] > 0
+    assert budget.experiment_work(exp.name, "lqg2d", tmp_path / "book").seconds == pytest.approx(line["seconds"])
 
 
 def test_cartpole_counts_one_normal_per_lived_step(store, monkeypatch):

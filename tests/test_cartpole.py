@@ -88,7 +88,7 @@ def test_thesis_settings_and_bound_constants() -> None:
     assert (task.reward_bound, task.action_bound, task.action_volume) == (1.0, 10.0, 20.0)
     assert (task.gamma, task.horizon, task.state_dim, task.action_dim) == (0.99, 200, 4, 1)
     c = TaskConstants.from_task(task, sigma=1.0)
-    assert (c.R, c.M_phi, c.A_volume, c.A_bar, c.H) == (1.0, task.feature_bound, 20.0, 10.0, 200)
+    assert (c.R, c.M_phi, c.action_volume, c.A_bar, c.H) == (1.0, task.feature_bound, 20.0, 10.0, 200)
 
 
 def test_termination_thresholds() -> None:
@@ -371,7 +371,7 @@ def test_authors_settings_names_and_constants() -> None:
     assert CartPole(gamma=0.9).setting_name() == "cartpole[gamma=0.9]"
     # The constants are written in constants_gamma; the simulation keeps gamma = 1 (undiscounted).
     k = TaskConstants.from_task(authors, 1.0)
-    assert (k.gamma, k.R, k.M_phi, k.A_volume) == (0.9, 1.0, 10.0, 20.0)
+    assert (k.gamma, k.R, k.M_phi, k.action_volume) == (0.9, 1.0, 10.0, 20.0)
     assert authors.simulate_gain(np.zeros(4), 1.0, 5, 0).gamma == 1.0
     assert TaskConstants.from_task(CartPole(), 1.0).gamma == 0.99
     with pytest.raises(ValueError, match="^gamma "):  # gamma = 1 in the printed constant: 1 / (1 - gamma)

@@ -51,7 +51,7 @@ def test_default_penalty_constant_is_unchanged() -> None:
 
 @pytest.mark.parametrize("gamma", [0.9, 0.99, 0.999])
 def test_horizon_terms(gamma: float) -> None:
-    k = dict(R=1.0, M_phi=2.0, A_volume=20.0, A_bar=10.0, gamma=gamma, H=200, sigma=1.0)
+    k = dict(R=1.0, M_phi=2.0, action_volume=20.0, A_bar=10.0, gamma=gamma, H=200, sigma=1.0)
     eff = TaskConstants(**k)
     trunc = TaskConstants(**k, horizon_term="truncated")
     hor = TaskConstants(**k, horizon_term="horizon")
@@ -70,13 +70,13 @@ def test_horizon_terms(gamma: float) -> None:
 
 
 def test_long_horizon_truncated_tends_to_effective() -> None:
-    k = dict(R=1.0, M_phi=1.0, A_volume=2.0, A_bar=1.0, gamma=0.9, sigma=1.0)
+    k = dict(R=1.0, M_phi=1.0, action_volume=2.0, A_bar=1.0, gamma=0.9, sigma=1.0)
     assert penalty_constant(TaskConstants(**k, H=10_000, horizon_term="truncated")) == pytest.approx(
         penalty_constant(TaskConstants(**k, H=10_000)), rel=1e-12)
 
 
 def test_undiscounted_needs_a_finite_horizon_term() -> None:
-    k = dict(R=1.0, M_phi=1.0, A_volume=2.0, A_bar=1.0, gamma=1.0, H=200, sigma=1.0)
+    k = dict(R=1.0, M_phi=1.0, action_volume=2.0, A_bar=1.0, gamma=1.0, H=200, sigma=1.0)
     with pytest.raises(ValueError, match="^gamma "):
         TaskConstants(**k)
     for term in ("truncated", "horizon"):
@@ -91,7 +91,7 @@ def test_task_settings_reach_the_constants() -> None:
     task = CartPole.thesis_doubled(gamma=0.995, feature_bound=1.0, action_space_volume=2.0, reward_bound=3.0,
                                    horizon_term="truncated")
     k = TaskConstants.from_task(task, 1.0)
-    assert (k.R, k.M_phi, k.A_volume, k.A_bar, k.gamma, k.H, k.horizon_term) == (
+    assert (k.R, k.M_phi, k.action_volume, k.A_bar, k.gamma, k.H, k.horizon_term) == (
         3.0, 1.0, 2.0, 10.0, 0.995, 200, "truncated")
     assert CartPole().action_volume == 20.0
 

@@ -67,7 +67,7 @@ def test_a_small_comparison_is_stored_seeded_and_resumable(tmp_path: Path) -> No
     assert set(search) == {"seed-1000.npz", "seed-1001.npz"}
     names = [c.name for c in cmp.configs(first.steps)]
     assert list(first.scores) == names and all(len(first.records[n]) == 2 for n in names)
-    assert all(sorted(p.name for p in (tmp_path / "pendulum" / n).glob("seed-*.npz")) == ["seed-0.npz", "seed-1.npz"]
+    assert all(sorted(p.name for p in (tmp_path / "pendulum" / n).glob("*/seed-*.npz")) == ["seed-0.npz", "seed-1.npz"]
                for n in names)
     # Read back, not recomputed: the same numbers, no new file.
     files = sorted(p.stat().st_mtime_ns for p in tmp_path.rglob("*.npz"))
@@ -131,7 +131,8 @@ def test_update_terms_read_the_records(tmp_path: Path) -> None:
 def test_run_group_first_seed(tmp_path: Path) -> None:
     cfg = RunConfig("x", method=Vanilla(100, FixedStep(1e-4)), task=Pendulum(), theta0=(0.0, 0.0, 0.0), budget=200)
     recs = run_configs([cfg], 2, tmp_path, jobs=1, progress=False, first_seed=5)["x"]
-    assert sorted(p.name for p in (tmp_path / "x").iterdir() if p.suffix == ".npz") == ["seed-5.npz", "seed-6.npz"]
+    stored = sorted(p.name for p in (tmp_path / "x" / cfg.key()).iterdir() if p.suffix == ".npz")
+    assert stored == ["seed-5.npz", "seed-6.npz"]
     assert [r.config["seed"] for r in recs] == [5, 6]
     assert np.array_equal(recs[0].theta, cfg.run(5).theta)
     with pytest.raises(ValueError, match="^first_seed"):

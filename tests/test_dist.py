@@ -16,6 +16,11 @@ is checked as a complete site: ``sha256sum -c SHA256SUMS`` passes, every local `
 schemes (http, https, mailto, data, javascript) are not followed; HTML files under
 ``_static/`` (the themes' Jinja templates, copied as they are) are not pages. Packing twice
 gives the same bytes.
+
+Unpacking (``test_extract_archive_*``): the tarballs are unpacked by ``conftest.extract_archive``,
+``filter="data"`` where tarfile has it (Python 3.11.4 on) and the same checks member by member on
+Debian 12's Python 3.11.2 (``tools/test_debian_python.sh`` runs this file there). Both ways, on any
+Python, refuse each archive that the data filter refuses and unpack a site as it does.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from __future__ import annotations
 import ast
 import hashlib
 import importlib.util
+import io
 import json
 import os
 import posixpath
@@ -33,7 +39,7 @@ import tarfile
 import textwrap
 import time
 import zipfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from html.parser import HTMLParser
 from pathlib import Path
@@ -43,6 +49,7 @@ import pytest
 from test_readme import README, python_blocks
 
 import safepg
+from conftest import extract_archive
 
 ROOT = Path(__file__).resolve().parents[1]
 REQUIREMENTS = ROOT / "requirements.txt"
@@ -417,7 +424,7 @@ def test_site_tarball_is_deterministic(dist: Path, tmp_path: Path) -> None:
 
 def test_site_links_and_anchors_resolve(dist: Path, tmp_path: Path) -> None:
     with tarfile.open(dist / BOOK_TARBALL) as tar:
-        tar.extractall(tmp_path, filter="data")
+        extract_archive(tar, tmp_path)
     site = tmp_path / f"safepg-book-{VERSION}"
     assert (site / "index.html").is_file()
     start = time.perf_counter()
@@ -428,3 +435,102 @@ def test_site_links_and_anchors_resolve(dist: Path, tmp_path: Path) -> None:
     print("link check of the unpacked book:", json.dumps(summary))
     assert report.pages > 5 and report.links > 100
     assert not report.broken, f"{len(report.broken)} broken links or anchors:\n" + "\n".join(report.broken)
+
+
+# --- unpacking on Debian 12's Python 3.11.2 ---------------------------------------------------
+
+
+def _entry(name: str, kind: bytes = tarfile.REGTYPE, data: bytes = b"", linkname: str = "",
+           mode: int = 0o644) -> tuple[tarfile.TarInfo, bytes]:
+    info = tarfile.TarInfo(name)
+    info.type, info.linkname, info.mode, info.size, info.mtime = kind, linkname, mode, len(data), 1_700_000_000
+    if kind == tarfile.CHRTYPE:
+        info.devmajor, info.devminor = 1, 3
+    return info, data
+
+
+def _archive(path: Path, *entries: tuple[tarfile.TarInfo, bytes]) -> Path:
+    with tarfile.open(path, "w") as tar:
+        for info, data in entries:
+            tar.addfile(info, io.BytesIO(data) if info.isreg() else None)
+    return path
+
+
+#: Archives that ``filter="data"`` refuses, by their destination folder; each aims at ``outside/`` beside it.
+REFUSED: dict[str, Callable[[Path], list[tuple[tarfile.TarInfo, bytes]]]] = {
+    "a name with ..": lambda dest: [_entry("../outside/evil.txt", data=b"x")],
+    "a symlink out": lambda dest: [_entry("link", tarfile.SYMTYPE, linkname="../outside")],
+    "a symlink deeper out": lambda dest: [_entry("a/b", tarfile.DIRTYPE, mode=0o755),
+                                          _entry("a/b/link", tarfile.SYMTYPE, linkname="../../../outside/x")],
+    "an absolute symlink": lambda dest: [_entry("link", tarfile.SYMTYPE, linkname="/etc/passwd")],
+    "an absolute symlink into the folder": lambda dest: [_entry("link", tarfile.SYMTYPE, linkname=str(dest / "x"))],
+    "a hard link out": lambda dest: [_entry("hard", tarfile.LNKTYPE, linkname="../outside/secret")],
+    # Lexically here/../evil.txt is inside; through the symlink extracted first it is not.
+    "a path through a symlink": lambda dest: [_entry("here", tarfile.SYMTYPE, linkname="."),
+                                              _entry("here/../outside/evil.txt", data=b"x")],
+    "a device": lambda dest: [_entry("null", tarfile.CHRTYPE)],
+    "a pipe": lambda dest: [_entry("pipe", tarfile.FIFOTYPE)],
+}
+
+
+@pytest.fixture(params=["this interpreter", "fallback"])
+def extraction(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """``extract_archive`` as the running Python has it (``filter="data"`` from 3.11.4 on), and its
+    fallback of Python 3.11.2 (Debian 12) on any Python: ``tarfile.data_filter`` taken away."""
+    if request.param == "fallback":
+        monkeypatch.delattr(tarfile, "data_filter", raising=False)
+    return request.param
+
+
+@pytest.mark.parametrize("case", REFUSED)
+def test_extract_archive_refuses_what_the_data_filter_refuses(case: str, extraction: str, tmp_path: Path) -> None:
+    (tmp_path / "outside").mkdir()
+    (tmp_path / "outside" / "secret").write_text("secret")
+    dest = tmp_path / "dest"
+    path = _archive(tmp_path / "evil.tar", *REFUSED[case](dest))
+    with tarfile.open(path) as tar, pytest.raises(tarfile.TarError):
+        extract_archive(tar, dest)
+    assert sorted(p.name for p in (tmp_path / "outside").iterdir()) == ["secret"]
+
+
+def test_extract_archive_keeps_absolute_names_inside(extraction: str, tmp_path: Path) -> None:
+    """An absolute name: the data filter extracts it under the destination (its ``/`` stripped), the
+    fallback refuses it; neither writes where it points."""
+    target = tmp_path / "outside" / "abs.txt"
+    path = _archive(tmp_path / "abs.tar", _entry(str(target), data=b"x"))
+    with tarfile.open(path) as tar:
+        if hasattr(tarfile, "data_filter"):
+            extract_archive(tar, tmp_path / "dest")
+            assert (tmp_path / "dest" / str(target).lstrip("/")).read_bytes() == b"x"
+        else:
+            with pytest.raises(tarfile.TarError, match="absolute path"):
+                extract_archive(tar, tmp_path / "dest")
+    assert not target.exists()
+
+
+def test_extract_archive_extracts_a_site(extraction: str, tmp_path: Path) -> None:
+    """What the book's tarball holds (folders, files, links inside) comes out as the data filter gives
+    it: contents, links, mtimes, and modes without setuid nor write for group and others (folders: the
+    umask's, not the archive's)."""
+    path = _archive(tmp_path / "site.tar",
+                    _entry("site", tarfile.DIRTYPE, mode=0o755),
+                    _entry("site/index.html", data=b"<p>home</p>", mode=0o666),
+                    _entry("site/run.sh", data=b"#!/bin/sh\n", mode=0o4775),
+                    _entry("site/_static", tarfile.DIRTYPE, mode=0o755),
+                    _entry("site/_static/a.css", data=b"a {}", mode=0o400),
+                    _entry("site/latest", tarfile.SYMTYPE, linkname="_static/a.css"),
+                    _entry("site/copy.html", tarfile.LNKTYPE, linkname="site/index.html"))
+    dest = tmp_path / "dest"
+    with tarfile.open(path) as tar:
+        extract_archive(tar, dest)
+    site = dest / "site"
+    assert sorted(p.relative_to(site).as_posix() for p in site.rglob("*")) == [
+        "_static", "_static/a.css", "copy.html", "index.html", "latest", "run.sh"]
+    assert (site / "index.html").read_bytes() == (site / "copy.html").read_bytes() == b"<p>home</p>"
+    assert os.readlink(site / "latest") == "_static/a.css" and (site / "latest").read_bytes() == b"a {}"
+    modes = {name: (site / name).stat().st_mode & 0o7777 for name in ("index.html", "run.sh", "_static/a.css")}
+    assert modes == {"index.html": 0o644, "run.sh": 0o755, "_static/a.css": 0o600}
+    assert (site / "run.sh").stat().st_mtime == 1_700_000_000
+    umask = os.umask(0o022)
+    os.umask(umask)
+    assert {(site / d).stat().st_mode & 0o7777 for d in ("", "_static")} == {0o777 & ~umask}

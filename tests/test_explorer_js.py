@@ -81,7 +81,8 @@ def test_lqg_closed_form():
 @pytest.mark.parametrize("sigma", [0.5, 1.0, 2.0])
 def test_constants_and_bounds(sigma):
     k = TaskConstants.from_task(LQG.thesis_1d(), sigma)
-    kj = f"{{R: {k.R}, M: {k.M_phi}, Avol: {k.A_volume}, Abar: {k.A_bar}, gamma: {k.gamma}, H: {k.H}, sigma: {sigma}}}"
+    kj = (f"{{R: {k.R}, M: {k.M_phi}, Avol: {k.action_volume}, Abar: {k.A_bar}, gamma: {k.gamma}, H: {k.H}, "
+          f"sigma: {sigma}}}")
     js = run_js([f"lib.penalty({kj})", f"lib.varReinforce({kj})", f"lib.varGpomdp({kj})", f"lib.rangeBound({kj})",
                  "lib.chebyshev(0.3, 50)", "lib.hoeffding(0.3, 40)", "lib.bernstein(0.3, 12, 40)"])
     assert js[0] == pytest.approx(penalty_constant(k), rel=1e-12)

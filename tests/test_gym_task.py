@@ -222,8 +222,10 @@ def test_learning_loops_accept_the_task() -> None:
     task = counter_task()
     rec = vanilla_pg(task, 0.0, 1.0, batch_size=8, step=FixedStep(0.01), budget=32, rng=0)
     assert rec.iterations == 4 and np.all(np.isnan(rec.J)) and np.all(np.isfinite(rec.J_hat))
-    # No closed-form J: its improvement ratio is unknown (NaN), not 0; J_hat's is measured.
-    assert np.isnan(rec.improvement_ratio()) and np.isnan(rec.summary()["improvement_ratio"])
+    # No closed-form J: its improvement ratio is unknown (NaN), not 0; J_hat's is measured, and is
+    # what the run is judged on by default.
+    assert np.isnan(rec.improvement_ratio("J")) and rec.performance_field == "J_hat"
+    assert rec.improvement_ratio() == rec.improvement_ratio("J_hat") == rec.summary()["improvement_ratio"]
     # J_hat's is measured: the share of the 3 updates after which the next batch's average return did not fall.
     rises = np.diff(rec.J_hat) >= 0
     assert 0 < rises.sum() < 3  # this run rises and falls, so counting falls instead would give another share

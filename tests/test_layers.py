@@ -5,7 +5,10 @@
 - only ``safepg.__main__`` imports ``safepg.cli``;
 - the modules import one another without cycles;
 - no module imports another's private names, nor a private module from another directory;
-- no module is longer than :data:`MAX_LINES` unless :data:`LONG_MODULES` says why.
+- no module is longer than :data:`MAX_LINES` unless :data:`LONG_MODULES` says why;
+- no core module defines the book's campaign machinery (:data:`CAMPAIGN_NAMES`, a prefetch): it is
+  ``safepg.thesis.campaign``'s and ``safepg.thesis.prefetch``'s, and the runner only reports to a
+  callback it is given.
 
 The graph and the rules are in ``tests/layers.py``; :func:`test_probe_rules_fail` runs them on
 small fake trees to show that each rule reports what it should, and nothing on a clean tree.
@@ -13,6 +16,7 @@ small fake trees to show that each rule reports what it should, and nothing on a
 
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 import pytest
@@ -43,6 +47,10 @@ LONG_MODULES: dict[str, str] = {
 }
 
 
+#: The book's campaign machinery (safepg.thesis.campaign): no core module defines these names.
+CAMPAIGN_NAMES = ("compile_once", "record_timing", "TIMING_FILE")
+
+
 def check_layers(tree: Tree) -> list[str]:
     """Core modules importing the thesis layer or the command line."""
     return layer_violations(tree, upper=(THESIS, CLI), exempt=(THESIS, CLI, ENTRY))
@@ -51,6 +59,32 @@ def check_layers(tree: Tree) -> list[str]:
 def check_cli(tree: Tree) -> list[str]:
     """Modules other than the entry point importing the command line."""
     return importer_violations(tree, CLI, allowed=(ENTRY,))
+
+
+def _defined(path: Path) -> list[tuple[int, str]]:
+    """Every name a module's source defines (functions, classes, assignments, at any depth), with its line."""
+    out = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            out.append((node.lineno, node.name))
+        elif isinstance(node, ast.Assign | ast.AnnAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            out += [(t.lineno, t.id) for target in targets for t in ast.walk(target) if isinstance(t, ast.Name)]
+    return out
+
+
+def check_campaign(tree: Tree) -> list[str]:
+    """Core modules that define the book's campaign machinery: a name of :data:`CAMPAIGN_NAMES`, a
+    prefetch (a module or a name with ``prefetch`` in it)."""
+    found = []
+    for name, module in sorted(tree.modules.items()):
+        if within(name, THESIS) or name in (CLI, ENTRY):
+            continue
+        if "prefetch" in name.rpartition(".")[2].lower():
+            found.append(f"{tree.where(name)}: {name} is a prefetch")
+        found += [f"{tree.where(name, line)}: {name} defines {n}" for line, n in sorted(_defined(module.path))
+                  if n in CAMPAIGN_NAMES or "prefetch" in n.lower()]
+    return found
 
 
 def check_size(tree: Tree, allowed: dict[str, str] = LONG_MODULES) -> list[str]:
@@ -75,6 +109,15 @@ def test_scan_sees_the_package(tree: Tree) -> None:
 def test_core_does_not_import_thesis_or_cli(tree: Tree) -> None:
     found = check_layers(tree)
     assert not found, report(f"imports of {THESIS} or {CLI} by the core", found)
+
+
+def test_core_does_not_define_the_campaign_machinery(tree: Tree) -> None:
+    found = check_campaign(tree)
+    assert not found, report("definitions of the book's campaign machinery in the core", found)
+    # ... and the thesis layer does (a rename there would leave this test checking nothing).
+    campaign = tree.modules[f"{THESIS}.campaign"].path
+    assert set(CAMPAIGN_NAMES) <= {n for _, n in _defined(campaign)}
+    assert f"{THESIS}.prefetch" in tree.modules
 
 
 def test_only_main_imports_cli(tree: Tree) -> None:
@@ -182,3 +225,24 @@ def test_probe_rules_fail(tmp_path: Path) -> None:
     assert check_size(tree, allowed={"safepg/huge.py": "one table", "safepg/gone.py": "split"}) == [
         "safepg/gone.py: in the allow-list but absent",
     ]
+
+
+def test_probe_campaign_rule_fails(tmp_path: Path) -> None:
+    """The campaign machinery in the core is reported, name by name; in the thesis layer it is not."""
+    tree = write(tmp_path, {**CLEAN,
+                            "runner.py": ("import json\n\nTIMING_FILE = 'timing.jsonl'\n\n\n"
+                                          "def record_timing(folder):\n    pass\n"),
+                            "envs/warm.py": "def run():\n    def compile_once(configs):\n        return 0\n",
+                            "book_prefetch.py": "x = 1\n",
+                            "tasks.py": "class Prefetcher:\n    pass\n",
+                            "thesis/campaign.py": ("TIMING_FILE = 'timing.jsonl'\n\n\n"
+                                                   "def compile_once(configs):\n    return 0\n"),
+                            "thesis/prefetch.py": "def prefetch():\n    pass\n"})
+    assert check_campaign(tree) == [
+        "safepg/book_prefetch.py: safepg.book_prefetch is a prefetch",
+        "safepg/envs/warm.py:2: safepg.envs.warm defines compile_once",
+        "safepg/runner.py:3: safepg.runner defines TIMING_FILE",
+        "safepg/runner.py:6: safepg.runner defines record_timing",
+        "safepg/tasks.py:1: safepg.tasks defines Prefetcher",
+    ]
+    assert check_campaign(write(tmp_path / "clean", CLEAN)) == []

@@ -43,6 +43,7 @@ from safepg.envs.lqg import LQG
 from safepg.learning import adaptive_pg, learn, vanilla_pg
 from safepg.meta import coordinate_step, n_star_search, optimal_batch_size, penalty_constant
 from safepg.options import Adaptive, ErrorModel, FixedStep, Gradient
+from safepg.record import CHECKPOINTS
 from safepg.streams import batch_key, trajectory_draws
 from safepg.thesis.explorers.live_learner import (
     learner_js,
@@ -439,8 +440,8 @@ def agreement(bound: str, er: bool, estimator: str, sigma: float, seeds: int = S
     finally:
         numba.set_num_threads(threads)
     values = {
-        "mean J at 10^5": ([s["J_at"]["100000"] for s in js], [r.J_at()["100000"] for r in py]),
-        "mean J at 10^6": ([s["J_at"]["1000000"] for s in js], [r.J_at()["1000000"] for r in py]),
+        "mean J at 10^5": ([s["J_at"]["100000"] for s in js], [r.J_at(CHECKPOINTS)["100000"] for r in py]),
+        "mean J at 10^6": ([s["J_at"]["1000000"] for s in js], [r.J_at(CHECKPOINTS)["1000000"] for r in py]),
         "mean iterations": ([s["iterations"] for s in js], [r.iterations for r in py]),
     }
     label = f"{bound}{' (e.r.)' if er else ''} | {estimator} | {sigma}"

@@ -12,10 +12,11 @@ import pytest
 from safepg.cli import main
 from safepg.constants import TaskConstants
 from safepg.envs.lqg import LQG
-from safepg.learning import LearningRecord, adaptive_pg, vanilla_pg
+from safepg.learning import adaptive_pg, learn, vanilla_pg
 from safepg.meta import coordinate_step, penalty_constant
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.policies import LinearGaussianPolicy
+from safepg.record import LearningRecord
 from safepg.tasks import MeasuredReturns
 
 ENV = LQG.thesis_1d()
@@ -156,6 +157,44 @@ def test_nan_gradient_raises():
         adaptive_pg(Broken(), budget=1000, rng=0)
 
 
+# ------------------------------------------------------------------ learn is the loop, the others build its method
+def _same_run(a: LearningRecord, b: LearningRecord) -> bool:
+    """Equal arrays, bit for bit, the same ending and the same ``config``."""
+    ends = ("interrupted", "diverged", "reached_target")
+    return _equal(a, b) and all(getattr(a, k) == getattr(b, k) for k in ends) and a.config == b.config
+
+
+@pytest.mark.parametrize("options", [
+    dict(error=ErrorModel("bernstein", range="empirical")),
+    # Every option set, the authors' departures included (batch_constants measures each batch).
+    dict(gradient=Gradient("reinforce"), error=ErrorModel("hoeffding", 0.95, 1280.0), batches=Batches(10, 5000, 300),
+         departures=Departures(True, True, True)),
+], ids=["bernstein", "authors"])
+def test_adaptive_pg_is_learn_with_an_adaptive(options):
+    wrapped = adaptive_pg(ENV, -0.1, 0.8, **options, budget=10_000, rng=np.random.default_rng(2))
+    direct = learn(ENV, Adaptive(**options), -0.1, 0.8, budget=10_000, rng=np.random.default_rng(2))
+    assert wrapped.iterations >= 3 and _same_run(wrapped, direct)
+
+
+@pytest.mark.parametrize("method", [
+    Vanilla(100, FixedStep(1e-3)),  # the task's compiled loop
+    Vanilla(200, SafeStep("coordinate", ErrorModel("chebyshev")), Gradient(baseline=False), Target(-1.5)),
+], ids=["fixed", "safe-target"])
+def test_vanilla_pg_is_learn_with_a_vanilla(method):
+    m = method
+    wrapped = vanilla_pg(ENV, -0.2, 0.8, batch_size=m.batch_size, step=m.step, gradient=m.gradient, target=m.target,
+                         budget=5_000, rng=np.random.default_rng(2))
+    direct = learn(ENV, method, -0.2, 0.8, budget=5_000, rng=np.random.default_rng(2))
+    assert wrapped.iterations >= 3 and _same_run(wrapped, direct)
+
+
+@pytest.mark.parametrize("bad", [ErrorModel(), FixedStep(1e-3), "adaptive", None], ids=repr)
+def test_learn_refuses_a_method_that_is_neither_adaptive_nor_vanilla(bad):
+    # Refused by name before anything else is checked: this budget is bad too.
+    with pytest.raises(TypeError, match=r"^method must be an Adaptive or a Vanilla, got "):
+        learn(ENV, bad, budget=1)
+
+
 def test_cli_learn_json(capsys):
     assert main(["learn", "--budget", "120000", "--bound", "bernstein", "--range", "empirical",
                  "--quiet", "--seed", "3"]) == 0
@@ -163,7 +202,8 @@ def test_cli_learn_json(capsys):
     for key in ("iterations", "trajectories", "theta", "J_initial", "J_star", "J_final", "J_at",
                 "upsilon_bar", "improvement_ratio", "batch_sizes"):
         assert key in out
-    assert out["trajectories"] == 120_000 and list(out["J_at"]) == ["100000"]
+    # The run's own checkpoints: its quarters.
+    assert out["trajectories"] == 120_000 and list(out["J_at"]) == ["30000", "60000", "90000", "120000"]
     assert out["J_initial"] == pytest.approx(-56.667, abs=1e-3)
     assert out["J_star"] == pytest.approx(-13.207, abs=1e-3)
     assert len(out["batch_sizes"]) == out["iterations"]
@@ -261,6 +301,10 @@ class _Simulated:
         self._lqg = LQG(**fields)
 
     def __getattr__(self, name):
+        # Not the LQG's action_dim: a task that has it without declaring safepg.tasks.ActionDimension
+        # is refused, and the 1-D LQG's is the default (1) anyway.
+        if name == "action_dim":
+            raise AttributeError(name)
         return getattr(self.__dict__["_lqg"], name)
 
 
@@ -310,7 +354,7 @@ def test_constants_batch_measures_R_and_M_phi_on_each_batch():
     R, M = np.abs(batch.rewards).max(), np.abs(batch.features).max()
     assert R < env.reward_bound and M < env.feature_bound  # measured values are below the bounds ...
     bounds = TaskConstants.from_task(env, 0.1)
-    c = penalty_constant(TaskConstants(R, M, bounds.A_volume, bounds.A_bar, 0.9, 20, 0.1))
+    c = penalty_constant(TaskConstants(R, M, bounds.action_volume, bounds.A_bar, 0.9, 20, 0.1))
     g = abs(rec.grad[0, 0])
     assert rec.alpha[0] == pytest.approx(coordinate_step(g, rec.eps[0], c, guarded=False), rel=1e-12)
     # ... so the penalty is smaller and the step larger than with the bounds (config["c"] keeps the latter).

@@ -159,7 +159,7 @@ def test_bounds_are_declared_exactly() -> None:
     assert (task.feature_bound, task.action_bound, task.action_volume) == (8.0, 2.0, 4.0)
     assert (task.gamma, task.horizon, task.init_angle, task.init_speed) == (0.99, 200, math.pi, 1.0)
     c = TaskConstants.from_task(task, 1.0)
-    assert (c.R, c.M_phi, c.A_volume, c.A_bar, c.H) == (task.reward_bound, 8.0, 4.0, 2.0, 200)
+    assert (c.R, c.M_phi, c.action_volume, c.A_bar, c.H) == (task.reward_bound, 8.0, 4.0, 2.0, 200)
     assert task_hooks(task).action_dim == 1
     # The bound is reached: upright-down (angle -pi after normalisation), top speed, full torque.
     assert step_reward(np.array([math.pi, 8.0]), 2.0) == -task.reward_bound

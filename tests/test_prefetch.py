@@ -93,7 +93,7 @@ def test_plain_lines_then_stored(tmp_path):
     assert len(lines) == 2, lines
     assert lines[0] == "run-book: table-5.1: computing 24 of 24 runs (0 stored)"
     assert lines[1].startswith("run-book: table-5.1: done, 24/24 runs, ") and " trajectories in " in lines[1]
-    assert len(list((tmp_path / "table-5.1").glob("*/seed-0.npz"))) == 24
+    assert len(list((tmp_path / "table-5.1").glob("*/*/seed-0.npz"))) == 24
 
     again = io.StringIO()
     assert prefetch.prefetch_experiment(_small(), tmp_path, jobs=1, stream=again, tty=False) == "stored"
@@ -174,14 +174,14 @@ def test_whole_book_run_on_a_small_plan(tmp_path, monkeypatch, capsys):
 
 
 def test_kernels_compile_once_for_what_is_left_to_compute(tmp_path, monkeypatch):
-    """Before the tasks, runner.compile_once gets the configs with runs to compute, and only those."""
+    """Before the tasks, campaign.compile_once gets the configs with runs to compute, and only those."""
     calls = []
 
     def compile_once(configs, jobs=-1):
         calls.append([c.name for c in configs])
         return len(configs)
 
-    monkeypatch.setattr(prefetch.runner, "compile_once", compile_once)
+    monkeypatch.setattr(prefetch.campaign, "compile_once", compile_once)
     tasks = [_small(), prefetch.Task("lqg2d", "table-5.3", seeds=1, budget=20_000)]
     prefetch.prefetch_experiment(tasks[0], tmp_path, jobs=1, stream=io.StringIO(), tty=False)
     out = io.StringIO()
@@ -227,6 +227,30 @@ def test_experiments_dispatched_together_store_what_each_alone_stores(tmp_path):
     assert again.getvalue().splitlines() == ["run-book: table-5.1: stored (24 runs)",
                                              "run-book: cartpole-baseline-authors: stored (1 runs)",
                                              "run-book: table-5.4-authors: stored (2 runs)"]
+
+
+def test_the_comparison_records_its_time_under_run_book_only(tmp_path, monkeypatch):
+    """run-book's comparison writes the timing lines budget.comparison_work reads (the comparison's folder and
+    its step search's); run_comparison called as the pendulum chapter calls it writes none."""
+    from dataclasses import replace
+
+    from safepg.comparison import StepSearch, pendulum_comparison, run_comparison
+    from safepg.thesis.budget import comparison_work
+    from safepg.thesis.campaign import TIMING_FILE
+
+    full = pendulum_comparison(seeds=2, budget=800, episodes=40)
+    small = replace(full, adaptive=full.adaptive[1:2], batch_sizes=(100,),
+                    search=StepSearch((1e-4,), seeds=1, episodes=20), looks=(100,))
+    run_comparison(small, tmp_path / "library", jobs=1)
+    assert list((tmp_path / "library").rglob("*.npz")) and not list((tmp_path / "library").rglob(TIMING_FILE))
+    monkeypatch.setattr(prefetch, "_comparison", lambda task: small)
+    task = prefetch.Task("pendulum", prefetch.COMPARISON, "comparison")
+    prefetch.prefetch_comparison(task, tmp_path / "book", jobs=1, stream=io.StringIO(), tty=False)
+    folder = tmp_path / "book" / small.name
+    assert sorted(tmp_path.rglob(TIMING_FILE)) == [folder / "search" / TIMING_FILE, folder / TIMING_FILE]
+    # The adaptive runs with the search, then the fixed batches: two lines in the comparison's folder.
+    assert len((folder / TIMING_FILE).read_text().splitlines()) == 2
+    assert comparison_work(tmp_path / "book").seconds > 0
 
 
 def test_one_experiment_asked_twice_is_computed_and_counted_once(tmp_path, monkeypatch):

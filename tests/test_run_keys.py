@@ -1,6 +1,6 @@
 """Every configuration of every experiment keeps the run key it had.
 
-Stored runs (``<results>/<experiment>/<config>/seed-<k>.npz``) are found, and accepted, by
+Stored runs (``<results>/<experiment>/<config>/<key>/seed-<k>.npz``) are found, and accepted, by
 their configuration's :meth:`safepg.runner.RunConfig.key`: a key that changes makes every
 stored run of that configuration stale, so the whole campaign (hours of computation) would be
 recomputed, and a refactor of the options or of how a configuration is spelt must not change

@@ -374,6 +374,6 @@ def test_a_folder_may_be_a_str_or_a_path(tmp_path, as_text):
     cfg = runner.RunConfig("tiny", method=Vanilla(10, FixedStep(1e-3)), budget=40)
     folder = str(tmp_path / "group") if as_text else tmp_path / "group"
     recs = runner.run_configs([cfg], 2, folder, jobs=1, progress=False)
-    assert len(recs["tiny"]) == 2 and (tmp_path / "group" / "tiny" / "seed-1.npz").is_file()
+    assert len(recs["tiny"]) == 2 and (tmp_path / "group" / "tiny" / cfg.key() / "seed-1.npz").is_file()
     again = runner.load_configs([cfg], 2, folder)["tiny"]
     assert [r.config["seed"] for r in again] == [0, 1] and runner.stored_run(folder, cfg, 0) is not None

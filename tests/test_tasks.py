@@ -9,17 +9,22 @@ import numpy as np
 import pytest
 
 from conftest import import_or_fail
+from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
+from safepg.envs.pendulum import Pendulum
 from safepg.learning import adaptive_pg, vanilla_pg
 from safepg.options import Batches, Departures, ErrorModel, FixedStep
 from safepg.tasks import (
+    DEFAULT_CONSTANTS_SETTINGS,
     ActionDimension,
+    ConstantsSettings,
     GradientBatch,
     GradientBatchConstants,
     MeasuredReturns,
     Performance,
     PerformanceBatch,
+    constants_settings,
     task_hooks,
 )
 
@@ -123,6 +128,83 @@ def test_a_declared_action_dimension_must_be_a_positive_integer(dim):
     Wide = type("Wide", (Minimal, ActionDimension), {"action_dim": dim})
     with pytest.raises(TypeError, match="action_dim"):
         task_hooks(Wide())
+
+
+def test_an_action_dimension_defined_without_being_declared_is_refused():
+    Undeclared = type("Undeclared", (Minimal,), {"action_dim": 2})  # would silently learn a 1-row gain
+    with pytest.raises(TypeError, match="defines action_dim but does not declare safepg.tasks.ActionDimension"):
+        task_hooks(Undeclared())
+    with pytest.raises(TypeError, match="declares ActionDimension but does not define action_dim"):
+        task_hooks(type("Declares", (Minimal, ActionDimension), {})())
+
+
+# ------------------------------------------------------------------ the settings of the bound constants
+def read_everywhere(task) -> list:
+    """Every reader of the settings: the check of the loops, the reader, the constants, a loop."""
+    return [lambda: task_hooks(task), lambda: constants_settings(task), lambda: TaskConstants.from_task(task, 1.0),
+            lambda: adaptive_pg(task, budget=1000, rng=0)]
+
+
+@pytest.mark.parametrize("name,value", [("horizon_term", "horizon"), ("constants_gamma", 0.5)])
+@pytest.mark.parametrize("where", ["class", "instance"])
+def test_a_setting_defined_without_being_declared_is_refused(name, value, where):
+    Undeclared = type("Undeclared", (Minimal,), {name: value} if where == "class" else {})
+    task = Undeclared()
+    if where == "instance":
+        setattr(task, name, value)
+    for read in read_everywhere(task):
+        with pytest.raises(TypeError, match=f"^Undeclared defines {name} but does not declare "
+                                            f"safepg.tasks.ConstantsSettings"):
+            read()
+
+
+@pytest.mark.parametrize("defined,missing", [
+    ({"horizon_terms": "horizon", "constants_gamma": None}, "horizon_term"),  # misspelt
+    ({"horizon_term": "horizon", "constant_gamma": 0.9}, "constants_gamma"),  # misspelt
+    ({"horizon_term": "truncated"}, "constants_gamma"),  # declared half
+    ({}, "horizon_term"),
+])
+def test_a_misspelt_or_half_declaration_is_refused(defined, missing):
+    task = type("Declares", (Minimal, ConstantsSettings), defined)()
+    for read in read_everywhere(task):
+        with pytest.raises(TypeError, match=f"^Declares declares ConstantsSettings but does not define {missing}$"):
+            read()
+
+
+def test_a_task_without_settings_gets_the_defaults():
+    task = Minimal()
+    assert DEFAULT_CONSTANTS_SETTINGS == ("effective", None)
+    assert constants_settings(task) == DEFAULT_CONSTANTS_SETTINGS
+    k = TaskConstants.from_task(task, 1.0)
+    assert (k.horizon_term, k.gamma) == ("effective", task.gamma)
+    assert constants_settings(LQG.thesis_2d()) == DEFAULT_CONSTANTS_SETTINGS  # the LQG declares none
+
+
+def test_declared_settings_are_read():
+    class Settled(Minimal, ConstantsSettings):
+        horizon_term = "truncated"
+        constants_gamma = 0.8
+
+    class InTheTasksGamma(Minimal, ConstantsSettings):  # None is a value: the task's own gamma
+        horizon_term = "horizon"
+        constants_gamma = None
+
+    assert constants_settings(Settled()) == ("truncated", 0.8)
+    k = TaskConstants.from_task(Settled(), 1.0)
+    assert (k.horizon_term, k.gamma, k.H) == ("truncated", 0.8, 20)
+    assert hooks_of(Settled()) == set()
+    k = TaskConstants.from_task(InTheTasksGamma(), 1.0)
+    assert (k.horizon_term, k.gamma) == ("horizon", 0.9)
+
+
+def test_the_librarys_tasks_declare_their_settings():
+    for task in (CartPole(horizon_term="truncated", constants_gamma=0.9), Pendulum(horizon_term="horizon")):
+        assert ConstantsSettings in type(task).__mro__
+        task_hooks(task)
+    assert constants_settings(CartPole(horizon_term="truncated", constants_gamma=0.9)) == ("truncated", 0.9)
+    assert constants_settings(Pendulum(horizon_term="horizon")) == ("horizon", None)
+    assert constants_settings(CartPole()) == constants_settings(Pendulum()) == DEFAULT_CONSTANTS_SETTINGS
+    assert ConstantsSettings not in LQG.__mro__
 
 
 # ------------------------------------------------------------------ declared hooks are used
@@ -247,5 +329,12 @@ def test_a_gym_task_declares_its_measured_returns():
     try:
         assert hooks_of(task) == {"measured_returns"}
         assert task_hooks(task).action_dim == 1
+        assert ConstantsSettings in type(task).__mro__ and constants_settings(task) == DEFAULT_CONSTANTS_SETTINGS
+    finally:
+        task.close()
+    task = GymTask("Pendulum-v1", horizon=5, gamma=0.9, reward_bound=17.0, feature_bound=8.0, horizon_term="horizon")
+    try:
+        assert constants_settings(task) == ("horizon", None)
+        assert TaskConstants.from_task(task, 1.0).horizon_term == "horizon"
     finally:
         task.close()

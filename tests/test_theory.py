@@ -17,7 +17,7 @@ from safepg.thesis import errata
 
 S17 = sp.sqrt(17)
 pos = st.floats(min_value=1e-2, max_value=1e2, allow_nan=False)
-K1 = TaskConstants(R=4.0, M_phi=2.0, A_volume=4.0, A_bar=2.0, gamma=0.9, H=20, sigma=1.0)
+K1 = TaskConstants(R=4.0, M_phi=2.0, action_volume=4.0, A_bar=2.0, gamma=0.9, H=20, sigma=1.0)
 K1_SUBS = {T.R: 4, T.M_phi: 2, T.A_vol: 4, T.A_bar: 2, T.gamma: sp.Rational(9, 10), T.H: 20, T.sigma: 1}
 
 

@@ -69,7 +69,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, GradientBatch, GradientBatchConstants, MeasuredReturns
+from safepg.tasks import ActionDimension, ConstantsSettings, GradientBatch, GradientBatchConstants, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 #: gymnasium id under which :class:`ContinuousCartPoleEnv` is registered.
@@ -189,7 +189,7 @@ def _check_integrator(integrator: str) -> None:
 
 
 @dataclass(frozen=True)
-class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension):
+class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension, ConstantsSettings):
     r"""The continuous cart-pole task of Section 5.3, simulated N carts at a time.
 
     Parameters
@@ -243,8 +243,9 @@ class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
         R of the bounds, max |r_t|. The reward is 1 while alive, so 1 (default) is the
         tight value; a larger R (e.g. H, a bound on the return) only makes the step smaller.
     action_space_volume : float or None
-        |A| of the penalty constant; None (default) is the length of the force interval,
-        2 A-bar = 20.
+        The given |A| of the penalty constant, read as :attr:`action_volume`; None (default):
+        the length of the force interval, 2 A-bar = 20. A frozen dataclass cannot have a field
+        and a property of one name, and renaming the field would change what the run keys hash.
     horizon_term : {"effective", "truncated", "horizon"}
         The horizon factor h that replaces 1 / (1 - gamma) in the penalty constant
         (Theorem 4.2.3 is stated for infinite-horizon discounted returns):
@@ -264,6 +265,9 @@ class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
         simulation nor the estimators. The authors' cart-pole scripts estimate the gradient of
         the undiscounted return (``gamma=1``, a ``sigma**l`` typed for ``gamma**l``) and put
         gamma = 0.9 into the penalty constant.
+
+    ``horizon_term`` and ``constants_gamma`` are the task's
+    :class:`~safepg.tasks.ConstantsSettings`.
     """
 
     pole_length: float = _POLE_LENGTH

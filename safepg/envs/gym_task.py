@@ -34,7 +34,7 @@ from safepg import portable
 from safepg.constants import HORIZON_TERMS
 from safepg.policies import LinearGaussianPolicy
 from safepg.rng import RNGLike, as_generator
-from safepg.tasks import ActionDimension, MeasuredReturns
+from safepg.tasks import ActionDimension, ConstantsSettings, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -76,7 +76,7 @@ def _constant_missing(name: str, what: str) -> ValueError:
     )
 
 
-class GymTask(MeasuredReturns, ActionDimension):
+class GymTask(MeasuredReturns, ActionDimension, ConstantsSettings):
     r"""A gymnasium environment (``Box`` observations and actions) as a safe-PG task.
 
     ``simulate(policy, n, rng)`` runs n episodes of horizon H at once in a
@@ -126,7 +126,8 @@ class GymTask(MeasuredReturns, ActionDimension):
         (N, d_phi). Default: the flattened observation. See :func:`!safepg.envs.gym_task.with_bias`.
     horizon_term : {"effective", "truncated", "horizon"}
         The horizon factor of the penalty constant (see
-        :class:`~safepg.constants.TaskConstants`).
+        :class:`~safepg.constants.TaskConstants`). With ``constants_gamma`` (always None: the
+        constants are written in ``gamma``) it is the task's :class:`~safepg.tasks.ConstantsSettings`.
     measure : {"discounted", "undiscounted"}
         What the learning loops record as J_hat (``measured_returns``): the discounted
         return (default, what the estimators optimise) or the plain sum of rewards
@@ -209,7 +210,7 @@ class GymTask(MeasuredReturns, ActionDimension):
             raise ValueError(f"measure must be 'discounted' or 'undiscounted', got {measure!r}")
         self.horizon = int(horizon)
         self.gamma = float(gamma)
-        self.horizon_term = horizon_term
+        self._horizon_term = horizon_term
         self.measure = measure
         self.reset_options = None if reset_options is None else dict(reset_options)
         self._reward_bound = _check_positive("reward_bound", reward_bound)
@@ -267,6 +268,16 @@ class GymTask(MeasuredReturns, ActionDimension):
         return self._action_dim
 
     # ------------------------------------------------------------ bound constants
+    @property
+    def horizon_term(self) -> str:
+        """The horizon factor of the penalty constant, as given (:class:`~safepg.tasks.ConstantsSettings`)."""
+        return self._horizon_term
+
+    @property
+    def constants_gamma(self) -> None:
+        """None: the constants are written in the task's ``gamma`` (:class:`~safepg.tasks.ConstantsSettings`)."""
+        return None
+
     @property
     def reward_bound(self) -> float:
         """R: bound on |r_t| (constructor argument; ``ValueError`` if it was not given)."""

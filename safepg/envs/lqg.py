@@ -90,6 +90,9 @@ class LQG(GradientBatch, FixedStepBatches, Performance, PerformanceBatch, Action
             raise ValueError(f"gamma must be in (0, 1), got {self.gamma}")
         if int(self.horizon) != self.horizon or self.horizon < 1:
             raise ValueError(f"horizon must be a positive integer, got {self.horizon}")
+        # A whole float (dim=2.0) is that integer: it sizes the matrices and ranges over steps.
+        object.__setattr__(self, "dim", int(self.dim))
+        object.__setattr__(self, "horizon", int(self.horizon))
         for name in ("state_bound", "action_bound"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")

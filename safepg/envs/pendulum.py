@@ -50,7 +50,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, GradientBatch, GradientBatchConstants, MeasuredReturns
+from safepg.tasks import ActionDimension, ConstantsSettings, GradientBatch, GradientBatchConstants, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 #: gymnasium's id of the task.
@@ -112,7 +112,7 @@ def _coefficients(gravity: float, mass: float, length: float) -> tuple[float, fl
 
 
 @dataclass(frozen=True)
-class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension):
+class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDimension, ConstantsSettings):
     r"""gymnasium's ``Pendulum-v1``, simulated N episodes at a time (module docstring).
 
     Parameters
@@ -137,6 +137,8 @@ class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
     constants_gamma : float or None
         The discount the bound constants are written in; None: ``gamma`` (the authors' cart-pole
         code put 0.9 there, see :class:`~safepg.envs.cartpole.CartPole`).
+
+    ``horizon_term`` and ``constants_gamma`` are the task's :class:`~safepg.tasks.ConstantsSettings`.
     """
 
     gamma: float = 0.99

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from safepg.learning import LearningRecord
+from safepg.record import LearningRecord
 from safepg.tables import Markdown, Table, markdown_table  # noqa: F401 (the chapters read them here too)
 from safepg.thesis.authors import strict_improvement_ratio
 

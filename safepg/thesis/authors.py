@@ -279,17 +279,17 @@ def grid_curve(batch_size: np.ndarray, values: np.ndarray, total: int = FIGURES_
     r"""A run's per-iteration values on the authors' trajectory grid, as ``plots/scaleData.m`` maps them.
 
     Their Figures 5.1-5.2 are this map of one run file each (``plots/save_scaledData.m@5810ee6:1-11``,
-    ``plots/scaleData.m@e4cdc9e:1-11``): for :math:`i = 0, \dots, 	ext{total}/	ext{step}`,
+    ``plots/scaleData.m@e4cdc9e:1-11``): for :math:`i = 0, \dots, \text{total}/\text{step}`,
 
     .. math::
-        n_i = 	ext{step}\; i, \qquad j_i = \maxig(1,\ \#\{k : N_1 + \dots + N_k < n_i\}ig), \qquad
-        z_i = y_{j_i}, \quad 	ext{drawn at } x_i = 	ext{step}\,(i + 1),
+        n_i = \text{step}\; i, \qquad j_i = \max\big(1,\ \#\{k : N_1 + \dots + N_k < n_i\}\big), \qquad
+        z_i = y_{j_i}, \quad \text{drawn at } x_i = \text{step}\,(i + 1),
 
     with :math:`N_k` the batch collected at iteration :math:`k` and :math:`y_k` its logged value. Their
     J column is the closed form at the parameter that collected batch :math:`k`, so at :math:`n`
     trajectories the curve shows the policy of the last batch that *ended* before :math:`n`, one
     update behind the policy collecting trajectory :math:`n`, and it is drawn one step to the right
-    (:math:`x = n + 	ext{step}`). Past the run's last batch the last value is held.
+    (:math:`x = n + \text{step}`). Past the run's last batch the last value is held.
 
     Parameters
     ----------

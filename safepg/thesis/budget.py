@@ -6,8 +6,8 @@ random numbers alone (the normals of the actions and the uniforms of the initial
 on every core. No simulation can beat it by much: a step costs a few multiplies, a normal
 about as many. benchmarks/bench_book.py measures the generators and builds the book from
 empty; this module reads, from the results store the build filled, what was computed and
-how long it took (``timing.jsonl`` of :func:`safepg.runner.record_timing`, the ``seconds``
-of the Table 5.1 sweep and of the safety measurements).
+how long it took (``timing.jsonl`` of :func:`safepg.thesis.campaign.record_timing`, which ``run-book``
+asks the runner for, the ``seconds`` of the Table 5.1 sweep and of the safety measurements).
 """
 
 from __future__ import annotations
@@ -20,21 +20,17 @@ from typing import Any
 
 from safepg import portable
 from safepg.envs.cartpole import CartPole
-from safepg.runner import RESULTS_VERSION, TIMING_FILE
-from safepg.thesis.cartpole_sweep import baseline_experiments
+from safepg.runner import RESULTS_VERSION
+from safepg.thesis.campaign import TIMING_FILE
+from safepg.thesis.chapters import CHAPTERS, chapter_experiments
 from safepg.thesis.experiment_store import experiment_folder, load_experiment
 from safepg.thesis.experiments import get_experiment
 from safepg.thesis.prefetch import COMPARISON, COMPILE_ONCE
 
-#: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order.
-CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {
-    "lqg1d": ("table-5.1", "table-5.1-printed-theta0", "table-5.1-no-baseline", "table-5.2",
-              "table-5.2-lemma-range", "table-5.2-raw-score", "table-5.1-authors", "table-5.2-authors",
-              "figures-5.1-5.2-authors", "table-5.1-authors-tail"),
-    "lqg2d": ("figures-5.5-5.6", "table-5.3", "table-5.3-authors"),
-    "cartpole": tuple(dict.fromkeys(("cartpole-baseline", "table-5.4", "cartpole-baseline-authors", "table-5.4-authors",
-                                     "table-5.4-authors-theta-star", *baseline_experiments(), "cartpole-sweep"))),
-}
+#: The experiments each chapter's notebook runs (its ``names`` list and its sweeps), in order: the
+#: chapters that run any, as :mod:`safepg.thesis.chapters` declares them.
+CHAPTER_EXPERIMENTS: dict[str, tuple[str, ...]] = {ch: chapter_experiments(ch) for ch in CHAPTERS
+                                                   if chapter_experiments(ch)}
 #: Stored computations that are not experiments: (folder, chapter).
 TABLE_51_SWEEP = "table-5.1-sweep"
 SAFETY_MC = "safety-mc"
@@ -169,7 +165,7 @@ def comparison_work(root: Path) -> Work | None:
 
 def compile_seconds(root: Path) -> float | None:
     """The seconds ``run-book`` spent compiling the kernels once before its tasks
-    (:func:`safepg.runner.compile_once`; in no experiment's time), or None if it did not."""
+    (:func:`safepg.thesis.campaign.compile_once`; in no experiment's time), or None if it did not."""
     return _timing_seconds(root / COMPILE_ONCE)
 
 

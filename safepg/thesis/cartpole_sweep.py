@@ -33,8 +33,8 @@ import numpy as np
 from safepg import portable
 from safepg.constants import TaskConstants
 from safepg.envs.cartpole import CartPole
-from safepg.learning import LearningRecord
 from safepg.meta import ALPHA_STAR_FACTOR, penalty_constant
+from safepg.record import LearningRecord
 from safepg.thesis.experiment_store import load_experiment, run_experiment
 from safepg.thesis.experiments import get_experiment, make_env
 from safepg.thesis.sweep_settings import CARTPOLE_SWEEP, SWEEP_BUDGET, SWEEP_SEEDS
@@ -85,9 +85,10 @@ def penalty_grid(gammas: tuple[float, ...] = GRID_GAMMAS, horizon_terms: tuple[s
     for gamma, term, m_phi, vol, r in itertools.product(gammas, horizon_terms, m_phis, volumes, rewards):
         if gamma == 1 and term == "effective":
             continue
-        constants = TaskConstants(R=r, M_phi=m_phi, A_volume=vol, A_bar=10.0, gamma=gamma, H=horizon, sigma=sigma,
-                                  horizon_term=term)
+        constants = TaskConstants(R=r, M_phi=m_phi, action_volume=vol, A_bar=10.0, gamma=gamma, H=horizon,
+                                  sigma=sigma, horizon_term=term)
         c = penalty_constant(constants)
+        # "A_volume" is the column the book's table of the grid (book/cartpole.ipynb) reads.
         rows.append({"gamma": gamma, "horizon_term": term, "h": constants.horizon_factor, "M_phi": m_phi,
                      "A_volume": vol, "R": r, "c": c, "max_step": max_safe_step(c),
                      "step_at_n_star": ALPHA_STAR_FACTOR / c,

@@ -39,8 +39,8 @@ from typing import Any
 import numpy as np
 
 from safepg.curve_tests import CurvePredictionTest, PermutationTest, block_means
-from safepg.learning import LearningRecord
 from safepg.options import Adaptive
+from safepg.record import LearningRecord
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, overlays
 from safepg.thesis.analysis import by_iteration

@@ -1,9 +1,12 @@
 """Where an experiment's runs are stored, and running what is missing.
 
-Seed k of config ``c`` of experiment ``e`` is ``<results>/<e>/<c>/seed-<k>.npz``; the
+Seed k of config ``c`` of experiment ``e`` is ``<results>/<e>/<c>/<key>/seed-<k>.npz``
+(:func:`safepg.runner.run_path`, ``<key>`` the config's :meth:`~safepg.runner.RunConfig.key`); the
 results folder is ``$SAFEPG_RESULTS`` or ``results/`` under the current directory.
 :func:`run_experiment` runs what is missing through :func:`safepg.runner.run_configs`,
-after the experiments it warm-starts from.
+after the experiments it warm-starts from; with ``timing=True`` (``run-book``'s campaign) each folder
+that runs were computed in gets a line of how long they took (:func:`safepg.thesis.campaign.record_timing`),
+otherwise nothing but the runs is written.
 
 A results folder holds one campaign (:class:`Campaign`, in its ``campaign.json``): the index of its
 first seed (another draw of the same experiments starts elsewhere, so that its seeds are disjoint)
@@ -20,9 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from safepg.learning import LearningRecord
-from safepg.runner import RunGroup, load_configs, run_configs, run_groups, stored_run
+from safepg.record import LearningRecord
+from safepg.runner import OnComputed, RunGroup, load_configs, run_configs, run_groups, stored_run
 from safepg.store import OnDamaged, results_dir
+from safepg.thesis.campaign import record_timing
 from safepg.thesis.experiments import Experiment, get_experiment, scaled
 
 
@@ -94,8 +98,14 @@ def _counts(exp: Experiment, root: Path | None, seeds: int | None) -> dict[str, 
     return {c.name: seeds for c in exp.configs} if seeds is not None else read_campaign(root).counts(exp)
 
 
+def _on_computed(timing: bool) -> OnComputed | None:
+    """What the runner is given to report computed runs: the campaign's timing file, or nothing."""
+    return record_timing if timing else None
+
+
 def run_experiment(exp: Experiment | str, seeds: int | None = None, budget: int | None = None, jobs: int = -1,
-                   root: Path | None = None, progress: bool = True) -> dict[str, list[LearningRecord]]:
+                   root: Path | None = None, progress: bool = True,
+                   timing: bool = False) -> dict[str, list[LearningRecord]]:
     """Run every missing (config, seed) of ``exp`` and return all records by config name.
 
     Finished runs are loaded, never recomputed (:func:`safepg.runner.run_configs`, which
@@ -103,7 +113,10 @@ def run_experiment(exp: Experiment | str, seeds: int | None = None, budget: int 
     warning and its run computed again. A warm-started experiment first runs the
     experiment it starts from, with the same seeds, and hands each seed's final parameters
     to the runner. ``jobs`` follows joblib: a positive count, or -1 for every core (-2 all
-    but one, ...).
+    but one, ...). With ``timing``, the experiment's folder (and that of each experiment it
+    starts from) gets a line of ``timing.jsonl`` for the runs computed in it
+    (:func:`safepg.thesis.campaign.record_timing`: ``run-book`` asks, for
+    :mod:`safepg.thesis.budget`); without, nothing but the runs is written.
     """
     exp = get_experiment(exp) if isinstance(exp, str) else exp
     exp = scaled(exp, seeds, budget)
@@ -111,18 +124,20 @@ def run_experiment(exp: Experiment | str, seeds: int | None = None, budget: int 
     # Starting policies first (in parallel), so no two workers compute the same one.
     for dep in _dependencies(exp):
         run_experiment(get_experiment(dep), seeds=_dependency_seeds(exp, dep, counts), jobs=jobs, root=root,
-                       progress=progress)
+                       progress=progress, timing=timing)
     return run_configs(exp.configs, counts, experiment_folder(exp, root), starts=_starts(exp, root, counts),
-                       jobs=jobs, progress=progress, desc=exp.name, first_seed=read_campaign(root).first_seed)
+                       jobs=jobs, progress=progress, desc=exp.name, first_seed=read_campaign(root).first_seed,
+                       on_computed=_on_computed(timing))
 
 
 def run_experiments(exps: Sequence[Experiment | str], jobs: int = -1, root: Path | None = None,
-                    progress: bool = True) -> dict[str, dict[str, list[LearningRecord]]]:
+                    progress: bool = True, timing: bool = False) -> dict[str, dict[str, list[LearningRecord]]]:
     """:func:`run_experiment` for several experiments, their missing runs dispatched together
     (:func:`safepg.runner.run_groups`: no worker waits at the end of one experiment while
     another has runs left). An experiment runs in a later dispatch than the ones it
     warm-starts from; those not in ``exps`` are run first (:func:`run_experiment`). Returns
-    each experiment's records by config name, by experiment name.
+    each experiment's records by config name, by experiment name. ``timing`` as in
+    :func:`run_experiment`: each folder gets its share of a dispatch's wall time.
     """
     pending = [get_experiment(e) if isinstance(e, str) else e for e in exps]
     out: dict[str, dict[str, list[LearningRecord]]] = {}
@@ -133,12 +148,12 @@ def run_experiments(exps: Sequence[Experiment | str], jobs: int = -1, root: Path
         for e in wave:  # stored by an earlier dispatch (then only read) or not in exps
             for dep in _dependencies(e):
                 run_experiment(get_experiment(dep), seeds=_dependency_seeds(e, dep, counts[e.name]), jobs=jobs,
-                               root=root, progress=progress)
+                               root=root, progress=progress, timing=timing)
         first = read_campaign(root).first_seed
         groups = [RunGroup(e.configs, counts[e.name], experiment_folder(e, root), _starts(e, root, counts[e.name]),
                            first) for e in wave]
         desc = wave[0].name if len(wave) == 1 else f"{len(wave)} experiments"
-        out.update(zip([e.name for e in wave], run_groups(groups, jobs, progress, desc)))
+        out.update(zip([e.name for e in wave], run_groups(groups, jobs, progress, desc, _on_computed(timing))))
         pending = [e for e in pending if e not in wave]
     return out
 

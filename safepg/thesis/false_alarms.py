@@ -40,8 +40,8 @@ import numpy as np
 
 from safepg.curve_tests import CurvePredictionTest, block_means
 from safepg.distributions import clopper_pearson
-from safepg.learning import LearningRecord
 from safepg.options import FixedStep, Vanilla
+from safepg.record import LearningRecord
 from safepg.runner import RunConfig
 from safepg.significance import PredictionTest, WelchTest
 from safepg.thesis.curve_bands import CURVE_BLOCKS

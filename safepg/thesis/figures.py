@@ -16,9 +16,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from safepg.bounds import ErrorBound
-from safepg.learning import LearningRecord
 from safepg.meta import n_star_search, n_zero, upsilon
-from safepg.record import on_trajectories
+from safepg.record import LearningRecord, on_trajectories
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band
 

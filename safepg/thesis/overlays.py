@@ -19,8 +19,7 @@ from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from safepg.envs.lqg import LQG
-from safepg.learning import LearningRecord
-from safepg.record import on_trajectories
+from safepg.record import LearningRecord, on_trajectories
 from safepg.stats import prediction_band95
 from safepg.thesis import authors, plotting
 from safepg.thesis.authors import LQG2D_BOUND, TABLE_5_4_BUDGET, AuthorsRun, cartpole_runs, lqg2d_runs

@@ -1,18 +1,17 @@
 r"""What the book's chapters compute, computed before ``jupyter-book build``, with progress.
 
-``make book`` runs ``python -m safepg run-book`` first. It reads the chapters' code cells
-(``_toc.yml``'s notebooks, in the book's order) and finds what they compute and store:
+``make book`` runs ``python -m safepg run-book`` first. It reads what the chapters compute and
+store as :mod:`safepg.thesis.chapters` declares it (``_toc.yml``'s notebooks, in the book's order;
+no notebook is parsed here, and a test checks the declaration against the notebooks' calls), one
+:class:`Task` per computation:
 
-- every experiment named in a cell that calls ``run_experiment``, with the seeds the
-  experiment defines, and the experiments they warm-start from;
-- ``scorecard(..., run=True)``: the scorecard's experiments (``NEEDED``, ``RANGE_VARIANTS``);
-- ``run_sweep(...)``: the cart-pole sweep's baseline searches (``SWEEP_SEEDS`` seeds), then
-  ``cartpole-sweep``;
-- ``sweep_paths(...)``: the Table 5.1 sweep (its literal keyword arguments kept);
+- the experiments of ``run_experiment``, ``scorecard(..., run=True)`` and ``run_sweep``, with the
+  seeds declared (else each experiment's own), and the experiments they warm-start from;
+- ``sweep_paths(...)``: the Table 5.1 sweep, with its declared keyword arguments;
 - ``measure_runs(...)``: the cart-pole chapter's safety measurements (:func:`safety_plan`);
 - ``run_comparison(pendulum_comparison(...))``: the pendulum chapter's comparison
   (:func:`safepg.comparison.run_comparison`: its step search, its runs and their safety
-  measurements), with the literal keyword arguments of ``pendulum_comparison``;
+  measurements), with the declared keyword arguments of ``pendulum_comparison``;
 - ``false_alarms_stored(...)``: the scorecard's false-alarm checks of its rules;
 
 and after the experiments, the scorecard's seed rule (:mod:`safepg.thesis.seed_rule`): the seeds its
@@ -22,7 +21,9 @@ Each is computed into the store the notebooks read (``results/`` beside ``book/`
 ``Path("..") / "results"``) by the very functions the notebooks call, with the same joblib
 parallelism (all cores), so that the notebooks then only read, and a notebook run on its own
 still computes whatever is missing. Nothing is computed twice: what is stored is loaded and
-reported as stored in one line.
+reported as stored in one line. Each folder runs are computed in gets a line of how long they took
+(``timing.jsonl``, :func:`safepg.thesis.campaign.record_timing`: run-book asks the runner for it, the
+library called from a notebook does not), which :mod:`safepg.thesis.budget` reads.
 
 Progress: on a terminal, one tqdm bar per task (runs done / total, trajectories, elapsed time
 and time left), redrawn every second; otherwise (CI, a log) plain lines: one when a task
@@ -31,13 +32,11 @@ starts, one when it ends, and at most one progress line every :data:`safepg.thes
 
 from __future__ import annotations
 
-import ast
-import json
 import os
 import re
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO, cast
@@ -45,16 +44,18 @@ from typing import Any, TextIO, cast
 import numpy as np
 
 from safepg import runner
-from safepg.learning import LearningRecord
+from safepg.record import LearningRecord
 from safepg.runner import RunConfig
+from safepg.thesis import campaign
+from safepg.thesis.chapters import CHAPTERS, Computation
 from safepg.thesis.experiment_store import experiment_folder, read_campaign, run_experiment, run_experiments
-from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment, scaled
+from safepg.thesis.experiments import Experiment, get_experiment, scaled
 from safepg.thesis.progress import PREFIX, Progress, duration, previous_seconds
 from safepg.thesis.progress import reporting_stored_runs as _reporting_stored_runs
 
 #: The book's notebooks: ``book/`` beside the package (an editable install of this clone).
 BOOK = Path(__file__).resolve().parents[2] / "book"
-#: The store's folder of the time :func:`safepg.runner.compile_once` took (its ``timing.jsonl``).
+#: The store's folder of the time :func:`safepg.thesis.campaign.compile_once` took (its ``timing.jsonl``).
 COMPILE_ONCE = "compile-once"
 #: The name of the pendulum chapter's comparison task (and its folder of the store).
 COMPARISON = "pendulum"
@@ -91,78 +92,43 @@ def chapters(book: Path = BOOK) -> list[Path]:
     return sorted(book.glob("*.ipynb"))
 
 
-def _code_cells(notebook: Path) -> Iterator[ast.Module]:
-    for cell in json.loads(notebook.read_text())["cells"]:
-        if cell["cell_type"] != "code":
-            continue
-        src = "".join(cell["source"])
-        # IPython magics and shell escapes are not Python.
-        src = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in src.splitlines())
-        try:
-            yield ast.parse(src)
-        except SyntaxError:
-            continue
+#: The declared calls (:data:`safepg.thesis.chapters.CALLS`) whose computations are experiments.
+EXPERIMENT_CALLS = frozenset({"run_experiment", "scorecard", "run_sweep"})
+#: The task of each other declared call: (kind, name).
+CALL_TASKS: dict[str, tuple[str, str]] = {
+    "sweep_paths": ("table-5.1-sweep", "table-5.1-sweep"),
+    "measure_runs": ("safety-mc", "safety-mc"),
+    "run_comparison": ("comparison", COMPARISON),
+    "false_alarms_stored": ("false-alarms", "false-alarms"),
+}
 
 
-def _called(tree: ast.AST) -> Iterator[tuple[str, ast.Call]]:
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Call):
-            f = node.func
-            name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else None
-            if name:
-                yield name, node
+def computation_tasks(chapter: str, computation: Computation) -> list[Task]:
+    """The tasks of one declared computation of ``chapter``: one per experiment, or one of :data:`CALL_TASKS`."""
+    if computation.call in EXPERIMENT_CALLS:
+        return [Task(chapter, e, seeds=computation.seeds) for e in computation.experiments]
+    kind, name = CALL_TASKS[computation.call]
+    return [Task(chapter, name, kind, options=computation.options)]
 
 
-def _literal_keywords(call: ast.Call, names: tuple[str, ...]) -> tuple[tuple[str, Any], ...]:
-    out = []
-    for kw in call.keywords:
-        if kw.arg in names:
-            try:
-                out.append((kw.arg, ast.literal_eval(kw.value)))
-            except ValueError:
-                continue
-    return tuple(sorted(out))
+def chapter_requests(notebook: Path, declared: Mapping[str, Sequence[Computation]] = CHAPTERS) -> list[Task]:
+    """What one chapter computes and stores, as :mod:`safepg.thesis.chapters` declares it, in order.
+
+    Raises
+    ------
+    ValueError
+        If the notebook declares nothing (not even that it computes nothing): a chapter added to the
+        book without a declaration would otherwise be computed by its notebook alone, unseen.
+    """
+    if notebook.stem not in declared:
+        raise ValueError(f"{notebook.name}: no declaration of what it computes in safepg.thesis.chapters.CHAPTERS "
+                         f"(declare its computing calls, or () if it has none)")
+    return [t for c in declared[notebook.stem] for t in computation_tasks(notebook.stem, c)]
 
 
-def _experiment_names(tree: ast.AST) -> list[str]:
-    """String constants of a cell that name an experiment, in order."""
-    return [n.value for n in ast.walk(tree)
-            if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value in EXPERIMENTS]
-
-
-def chapter_requests(notebook: Path) -> list[Task]:
-    """What one chapter's cells compute and store, in the order of its cells."""
-    from safepg.thesis.cartpole_sweep import baseline_experiments
-    from safepg.thesis.scorecard.rows import NEEDED, RANGE_VARIANTS
-    from safepg.thesis.sweep_settings import SWEEP_SEEDS
-
-    chapter, tasks = notebook.stem, []
-    for tree in _code_cells(notebook):
-        for name, call in _called(tree):
-            if name == "run_experiment":
-                tasks += [Task(chapter, e) for e in dict.fromkeys(_experiment_names(tree))]
-            elif name == "scorecard" and any(kw.arg == "run" and isinstance(kw.value, ast.Constant)
-                                             and kw.value.value is True for kw in call.keywords):
-                tasks += [Task(chapter, e) for e in (*NEEDED, *RANGE_VARIANTS) if e in EXPERIMENTS]
-            elif name == "run_sweep":
-                tasks += [Task(chapter, e, seeds=SWEEP_SEEDS) for e in baseline_experiments()]
-                tasks.append(Task(chapter, "cartpole-sweep"))
-            elif name == "sweep_paths":
-                tasks.append(Task(chapter, "table-5.1-sweep", "table-5.1-sweep",
-                                  options=_literal_keywords(call, ("jobs", "seeds", "budget"))))
-            elif name == "measure_runs":
-                tasks.append(Task(chapter, "safety-mc", "safety-mc"))
-            elif name == "false_alarms_stored":
-                tasks.append(Task(chapter, "false-alarms", "false-alarms"))
-            elif name == "pendulum_comparison":
-                tasks.append(Task(chapter, COMPARISON, "comparison",
-                                  options=_literal_keywords(call, ("seeds", "budget", "episodes"))))
-    return tasks
-
-
-def book_tasks(book: Path = BOOK) -> list[Task]:
-    """Every task of every chapter, in the book's order, each once, each experiment after the
-    experiment it warm-starts from (with as many seeds)."""
+def book_tasks(book: Path = BOOK, declared: Mapping[str, Sequence[Computation]] = CHAPTERS) -> list[Task]:
+    """Every task of every chapter of ``book`` (:func:`chapter_requests`), in the book's order, each once,
+    each experiment after the experiment it warm-starts from (with as many seeds)."""
     out: list[Task] = []
 
     def seeds_of(t: Task) -> int:
@@ -181,7 +147,7 @@ def book_tasks(book: Path = BOOK) -> list[Task]:
             out.append(t)
 
     for nb in chapters(book):
-        for t in chapter_requests(nb):
+        for t in chapter_requests(nb, declared):
             add(t)
     return out
 
@@ -237,7 +203,7 @@ def prefetch_experiment(task: Task, root: Path, jobs: int = -1, stream: TextIO |
                         previous_s=_previous_share(task, exp, missing, book))
     try:
         with _reporting_stored_runs(progress):
-            run_experiment(exp, jobs=jobs, root=root, progress=False)
+            run_experiment(exp, jobs=jobs, root=root, progress=False, timing=True)
     except BaseException:
         progress.close(finished=False)
         raise
@@ -308,7 +274,7 @@ def prefetch_experiments(tasks: list[Task], root: Path, jobs: int = -1, stream: 
 
     try:
         with _reporting_stored_runs(progress, stored):
-            run_experiments([exp for _, exp, _, _ in pending], jobs=jobs, root=root, progress=False)
+            run_experiments([exp for _, exp, _, _ in pending], jobs=jobs, root=root, progress=False, timing=True)
     except BaseException:
         progress.close(finished=False)
         raise
@@ -429,13 +395,14 @@ def prefetch_comparison(task: Task, root: Path, jobs: int = -1, stream: TextIO |
         return "stored"
     started = time.monotonic()
     _say(stream, f"{task.name}: computing its step search, its runs and their safety measurements")
-    run_comparison(cmp, root, jobs, report=lambda line: _say(stream, f"{task.name}: {line}"))
+    run_comparison(cmp, root, jobs, report=lambda line: _say(stream, f"{task.name}: {line}"),
+                   on_computed=campaign.record_timing)
     _say(stream, f"{task.name}: done in {duration(time.monotonic() - started)}")
     return "computed"
 
 
 def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> None:
-    """:func:`safepg.runner.compile_once` on the configs of the experiments that have runs to compute
+    """:func:`safepg.thesis.campaign.compile_once` on the configs of the experiments that have runs to compute
     (and of the pendulum's comparison, if it has)."""
     from joblib import effective_n_jobs
 
@@ -453,15 +420,15 @@ def _compile_once(tasks: list[Task], root: Path, jobs: int, stream: TextIO) -> N
             folder = experiment_folder(exp, root)
             # A file's presence is enough here (a stale or damaged one is recomputed all the same).
             seeds = _seeds(t, exp, root)
-            configs += [c for c in exp.configs if not all(runner.run_path(folder, c, k).exists()
+            configs += [c for c in exp.configs if not all(runner.is_stored(folder, c, k)
                                                           for k in seeds[c.name])]
     started = time.monotonic()
-    runs = runner.compile_once(configs, jobs)
+    runs = campaign.compile_once(configs, jobs)
     if runs:
         seconds = time.monotonic() - started
         (root / COMPILE_ONCE).mkdir(parents=True, exist_ok=True)
         # benchmarks/bench_book.py reads it
-        runner.record_timing(root / COMPILE_ONCE, seconds, runs, effective_n_jobs(jobs))
+        campaign.record_timing(root / COMPILE_ONCE, seconds, runs, effective_n_jobs(jobs))
         _say(stream, f"kernels compiled once, each task family in one worker, in {duration(seconds)}")
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from tqdm import tqdm
 
 from safepg import runner
-from safepg.learning import LearningRecord
+from safepg.record import LearningRecord
 from safepg.runner import RunConfig
 
 #: Seconds between two progress lines when the output is not a terminal.

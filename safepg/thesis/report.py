@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from safepg.definition import to_dict
-from safepg.learning import CHECKPOINTS, LearningRecord
 from safepg.options import FixedStep, Vanilla
+from safepg.record import CHECKPOINTS, LearningRecord
 from safepg.runner import RunConfig
 from safepg.stats import seed_summary95
 from safepg.thesis import authors

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from safepg.bounds import BOUNDS
-from safepg.learning import LearningRecord
 from safepg.options import ErrorModel
+from safepg.record import LearningRecord
 from safepg.thesis.explorers.component import Explorer, static_text
 
 #: Points of each drawn curve: enough for a 640 px plot.

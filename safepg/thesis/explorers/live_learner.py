@@ -43,9 +43,9 @@ import numpy as np
 from safepg import portable
 from safepg.definition import to_dict
 from safepg.envs.lqg import LQG
-from safepg.learning import LearningRecord, learn
+from safepg.learning import learn
 from safepg.options import Adaptive, Batches, Departures, FixedStep, Gradient, Vanilla
-from safepg.record import on_trajectories
+from safepg.record import CHECKPOINTS, LearningRecord, on_trajectories
 from safepg.thesis import plotting
 from safepg.thesis.analysis import by_iteration, mean_band
 from safepg.thesis.explorers.ch5_live import bound_control_error, fixed, thin
@@ -252,7 +252,7 @@ def still_tolerance(data: Mapping[str, Any], theta0: float = 0.0) -> float:
 def run_summary(rec: LearningRecord, tol: float) -> dict[str, Any]:
     """The page's summary of one run (``safepgLiveSummary``): safepg's, plus ``theta_moved``
     (:func:`theta_moved`) and ``ratio_vacuous`` (no iteration, or theta moved less than ``tol``)."""
-    s = rec.summary()
+    s = rec.summary(CHECKPOINTS)  # the thesis's checkpoints, not the run's own
     moved = theta_moved(rec.theta)
     return {"iterations": s["iterations"], "trajectories": s["trajectories"], "upsilon_bar": s["upsilon_bar"],
             "improvement_ratio": s["improvement_ratio"], "J_final": s["J_final"], "theta_final": s["theta"][0],

@@ -8,23 +8,22 @@ a field that may hold one of several types, or none (``Vanilla.step``, ``Vanilla
 is a name whose value is the type's name (``step: "SafeStep"``), followed by that type's fields.
 
 :func:`option_table` reads this table from the dataclasses themselves (fields, defaults and
-the allowed values of their ``Literal`` types). ``static/options.js`` holds it for the page,
-written by ``python -m safepg.thesis.explorers.option_names``; a test requires that file to
-be what this module writes. :func:`learner_options` flattens a method through the same
-table, so no name is spelt twice: changing an option changes the dataclass and this file.
+the allowed values of their ``Literal`` types) through :mod:`safepg.option_fields`, as the
+command line does. ``static/options.js`` holds it for the page, written by ``python -m
+safepg.thesis.explorers.option_names``; a test requires that file to be what this module writes.
+:func:`learner_options` flattens a method through the same table, so no name is spelt twice:
+changing an option changes the dataclass and this file.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import sys
-import types
-import typing
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-from safepg.definition import OPTION_TYPES, to_dict
+from safepg.definition import to_dict
+from safepg.option_fields import OptionField, option_fields
 from safepg.options import Adaptive, Method, Vanilla
 
 #: The run's own settings beside its method (:class:`~safepg.runner.RunConfig`'s fields that the
@@ -48,44 +47,17 @@ def camel(name: str) -> str:
     return head + "".join(part[:1].upper() + part[1:] for part in rest)
 
 
-def _alternatives(hint: Any) -> tuple[Any, ...]:
-    """The members of a union type hint (``X | None`` gives ``(X, NoneType)``), or the hint alone."""
-    if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
-        return typing.get_args(hint)
-    return (hint,)
-
-
-def _leaf(hint: Any) -> dict[str, Any]:
-    """The allowed values of a field's type hint: ``choices``, ``number``, ``integer``, ``nullable``."""
+def _leaf(f: OptionField) -> dict[str, Any]:
+    """The allowed values of a plain field: ``choices`` (a bool's are true and false), ``number``,
+    ``integer``, ``nullable``."""
     out: dict[str, Any] = {}
-    for arg in _alternatives(hint):
-        if arg is type(None):
-            out["nullable"] = True
-        elif arg is bool:
-            out["choices"] = [True, False]
-        elif typing.get_origin(arg) is Literal:
-            out.setdefault("choices", []).extend(typing.get_args(arg))
-        elif arg is int:
-            out["integer"] = True
-        elif arg is float:
-            out["number"] = True
-        else:
-            raise TypeError(f"the page learner has no spelling for a field of type {arg!r}")
+    choices = [True, False] * f.boolean + list(f.choices)
+    if choices:
+        out["choices"] = choices
+    for kind in ("integer", "number", "nullable"):
+        if getattr(f, kind):
+            out[kind] = True
     return out
-
-
-def _option_types(hint: Any) -> list[str] | None:
-    """The option types a field may hold (None when it holds plain values)."""
-    named = [a.__name__ for a in _alternatives(hint) if isinstance(a, type) and OPTION_TYPES.get(a.__name__) is a]
-    return named or None
-
-
-def _default(f: dataclasses.Field[Any]) -> Any:
-    if f.default is not dataclasses.MISSING:
-        return f.default
-    if f.default_factory is not dataclasses.MISSING:
-        return f.default_factory()
-    return dataclasses.MISSING
 
 
 def option_table() -> dict[str, Any]:
@@ -105,29 +77,23 @@ def option_table() -> dict[str, Any]:
     def visit(cls: type) -> None:
         if cls.__name__ in table:
             return
-        hints = typing.get_type_hints(cls)
         entries: dict[str, Any] = {}
         table[cls.__name__] = entries
-        for f in dataclasses.fields(cls):
-            if not f.init:
-                continue
-            hint, default = hints[f.name], _default(f)
-            named = _option_types(hint)
+        for f in option_fields(cls):
             entry: dict[str, Any] = {"field": f.name}
-            if named is not None:
-                nullable = type(None) in _alternatives(hint)
-                entry["types"] = named
-                entry["nested"] = len(named) == 1 and not nullable
-                if nullable:
+            if f.types:
+                entry["types"] = [t.__name__ for t in f.types]
+                entry["nested"] = len(f.types) == 1 and not f.nullable
+                if f.nullable:
                     entry["nullable"] = True
-                if default is not dataclasses.MISSING:
-                    entry["default"] = None if default is None else type(default).__name__
-                for name in named:
-                    visit(OPTION_TYPES[name])
+                if not f.required:
+                    entry["default"] = None if f.default is None else type(f.default).__name__
+                for t in f.types:
+                    visit(t)
             else:
-                entry.update(_leaf(hint))
-                if default is not dataclasses.MISSING:
-                    entry["default"] = default
+                entry.update(_leaf(f))
+                if not f.required:
+                    entry["default"] = f.default
             entries[camel(f.name)] = entry
 
     for method in METHODS:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from safepg.learning import LearningRecord
+from safepg.record import LearningRecord
 from safepg.thesis.curve_bands import (
     CurveScore,
     curve_holds,

@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 
 from safepg.envs.lqg import LQG
-from safepg.learning import LearningRecord
 from safepg.options import FixedStep, Vanilla
+from safepg.record import LearningRecord
 from safepg.significance import AllOf, PredictionTest
 from safepg.stats import prediction_interval95
 from safepg.thesis import authors

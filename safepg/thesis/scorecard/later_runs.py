@@ -10,8 +10,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from safepg.learning import LearningRecord
 from safepg.options import FixedStep, Vanilla
+from safepg.record import LearningRecord
 from safepg.stats import prediction_interval95
 from safepg.thesis.experiments import Experiment, method_of
 from safepg.thesis.scorecard import outputs

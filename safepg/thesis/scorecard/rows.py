@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping
 from pathlib import Path
 
-from safepg.learning import LearningRecord
+from safepg.record import LearningRecord
 from safepg.store import results_dir
 from safepg.thesis.experiment_store import load_experiment, run_experiment
 from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment

@@ -14,8 +14,8 @@ from dataclasses import replace
 from typing import Any
 
 from safepg import portable
-from safepg.learning import LearningRecord
 from safepg.options import Adaptive, FixedStep, Vanilla
+from safepg.record import LearningRecord
 from safepg.runner import RunConfig
 from safepg.significance import Test, WelchTest
 from safepg.thesis import authors as authors_tables
