@@ -467,9 +467,7 @@ def adaptive_pg(
     Returns
     -------
     LearningRecord
-        The per-iteration arrays; ``config`` holds the run's definition
-        (:func:`safepg.definition.run_definition`) and ``config["c"]``, the penalty constant
-        from the task's bounds.
+        As :func:`learn` returns it.
     """
     # Building the method checks each option's type, before anything else is looked at.
     return learn(task, Adaptive(gradient, error, batches, departures), theta0, sigma, budget=budget, rng=rng,

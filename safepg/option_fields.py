@@ -80,7 +80,7 @@ def alternatives(hint: Any) -> tuple[Any, ...]:
     return (hint,)
 
 
-def field_default(f: dataclasses.Field[Any]) -> Any:
+def _field_default(f: dataclasses.Field[Any]) -> Any:
     """A dataclass field's default, its ``default_factory``'s value, or :data:`REQUIRED`."""
     if f.default is not dataclasses.MISSING:
         return f.default
@@ -131,7 +131,7 @@ def option_fields(cls: type) -> tuple[OptionField, ...]:
     """
     hints = typing.get_type_hints(cls)
     docs = parameter_docs(cls)
-    return tuple(OptionField(cls, f.name, field_default(f), help=docs.get(f.name, ""),
+    return tuple(OptionField(cls, f.name, _field_default(f), help=docs.get(f.name, ""),
                              **_read_hint(cls, f.name, hints[f.name]))
                  for f in dataclasses.fields(cls) if f.init)
 
@@ -205,5 +205,5 @@ def plain(text: str) -> str:
     return re.sub(r"\s+", " ", text).strip()
 
 
-__all__ = ["REQUIRED", "OptionField", "alternatives", "field_default", "option_field", "option_fields",
+__all__ = ["REQUIRED", "OptionField", "alternatives", "option_field", "option_fields",
            "parameter_docs", "plain"]

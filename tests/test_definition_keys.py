@@ -23,17 +23,7 @@ from safepg.definition import _annotations, as_declared, declared_numbers, to_di
 from safepg.envs.cartpole import CartPole
 from safepg.envs.lqg import LQG
 from safepg.envs.pendulum import Pendulum
-from safepg.options import (
-    Adaptive,
-    Batches,
-    Departures,
-    ErrorModel,
-    FixedStep,
-    Gradient,
-    SafeStep,
-    Target,
-    Vanilla,
-)
+from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
 from safepg.runner import RunConfig
 
 BASE = RunConfig("x", task=LQG(), method=Adaptive(), theta0=(-0.5,), sigma=1.0, budget=20_000)

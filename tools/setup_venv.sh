@@ -3,7 +3,8 @@
 # (editable, from this clone) and the Jupyter kernel "python3" of this venv.
 #
 # Usage: tools/setup_venv.sh PYTHON   (the interpreter that creates .venv; with PYTHON_GIVEN=1,
-# as `make setup PYTHON=...` sets, an existing .venv of another interpreter is made anew)
+# as `make setup PYTHON=...` sets, an existing .venv of another interpreter is made anew;
+# SAFEPG_VENV=.venv-debian makes that folder instead, as tools/test_debian_python.sh does)
 #
 # Why a venv: nothing is installed into the interpreter that creates it. Debian's and
 # Ubuntu's python3 (also Fedora's, Homebrew's) refuse `pip install` (PEP 668,
@@ -17,7 +18,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python=${1:?usage: tools/setup_venv.sh PYTHON}
-venv="$(pwd)/.venv"
+venv="$(pwd)/${SAFEPG_VENV:-.venv}"
+name=${venv##*/}
 vpy="$venv/bin/python"
 stamp="$venv/.safepg-setup"
 say() { echo "setup: $*"; }
@@ -34,7 +36,7 @@ if [ -x "$vpy" ] && current=$(base_of "$vpy"); then
   if [ "${PYTHON_GIVEN:-}" = 1 ]; then
     wanted=$(base_of "$python") || die "cannot run PYTHON=$python"
     if [ "$wanted" != "$current" ]; then
-      say "PYTHON=$python is $wanted, .venv was made from $current: making .venv anew"
+      say "PYTHON=$python is $wanted, $name was made from $current: making $name anew"
       rm -rf "$venv"
     fi
   fi
@@ -59,7 +61,7 @@ if [ ! -x "$vpy" ]; then
       die "$base cannot create a virtual environment (no ensurepip): install $pkg (apt-get install $pkg) or set PYTHON to another Python >= 3.11"
     fi
   fi
-  say "creating .venv from $base (Python $version)"
+  say "creating $name from $base (Python $version)"
   "$base" -m venv "$venv"
 fi
 
@@ -88,9 +90,9 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$inputs" ]; then
   # before any kernel of that name in ~/.local/share/jupyter.
   "$vpy" -m ipykernel install --sys-prefix --name python3 >/dev/null
   echo "$inputs" > "$stamp"
-  say "installed requirements.txt and safepg into .venv in $((SECONDS - start)) s"
+  say "installed requirements.txt and safepg into $name in $((SECONDS - start)) s"
 else
-  say ".venv is up to date (requirements.txt, pyproject.toml and interpreter unchanged)"
+  say "$name is up to date (requirements.txt, pyproject.toml and interpreter unchanged)"
 fi
 
 # The kernel Jupyter Book and nbval will start: refuse to go on if it is not this venv's,

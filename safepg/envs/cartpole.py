@@ -264,10 +264,8 @@ class CartPole(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
         range) are written in; None (default): ``gamma``. Only the constants change, not the
         simulation nor the estimators. The authors' cart-pole scripts estimate the gradient of
         the undiscounted return (``gamma=1``, a ``sigma**l`` typed for ``gamma**l``) and put
-        gamma = 0.9 into the penalty constant.
-
-    ``horizon_term`` and ``constants_gamma`` are the task's
-    :class:`~safepg.tasks.ConstantsSettings`.
+        gamma = 0.9 into the penalty constant. With ``horizon_term``, the task's
+        :class:`~safepg.tasks.ConstantsSettings`.
     """
 
     pole_length: float = _POLE_LENGTH

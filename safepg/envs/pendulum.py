@@ -136,9 +136,8 @@ class Pendulum(GradientBatch, GradientBatchConstants, MeasuredReturns, ActionDim
         The horizon factor of the penalty constant (:class:`~safepg.constants.TaskConstants`).
     constants_gamma : float or None
         The discount the bound constants are written in; None: ``gamma`` (the authors' cart-pole
-        code put 0.9 there, see :class:`~safepg.envs.cartpole.CartPole`).
-
-    ``horizon_term`` and ``constants_gamma`` are the task's :class:`~safepg.tasks.ConstantsSettings`.
+        code put 0.9 there, see :class:`~safepg.envs.cartpole.CartPole`). With ``horizon_term``,
+        the task's :class:`~safepg.tasks.ConstantsSettings`.
     """
 
     gamma: float = 0.99
