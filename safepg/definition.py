@@ -12,14 +12,15 @@ its type named, every field present (defaults included):
 (:meth:`safepg.runner.RunConfig.key`), the records' ``config`` and the command line all read
 this one dictionary, under the option objects' own field names.
 
-Tasks enter by their fields: a frozen dataclass task (:class:`~safepg.envs.lqg.LQG`,
-:class:`~safepg.envs.cartpole.CartPole`, or a researcher's own) by its constructor's fields,
-and a task that defines ``definition()`` (:class:`~safepg.envs.gym_task.GymTask`) by the
-keyword arguments that method returns. A function inside a definition (a feature map, an
-environment factory) enters by a name that can be imported again, ``module:qualname``, or by
-the name given for it: a lambda or a nested function without one has no name that would
-change when it changes, and is refused where a definition must be exact (``exact=True``, the
-run keys).
+Tasks enter by their fields: a frozen dataclass task (:class:`~safepg.envs.cartpole.CartPole`,
+or a researcher's own) by its constructor's fields, and a task that declares
+:class:`safepg.tasks.Definition` (:class:`~safepg.envs.lqg.LQG`,
+:class:`~safepg.envs.gym_task.GymTask`) by the keyword arguments its ``definition()`` returns;
+one that declares :class:`safepg.tasks.FromDefinition` is built again by its ``from_definition``.
+A function inside a definition (a feature map, an environment factory) enters by a name that can
+be imported again, ``module:qualname``, or by the name given for it: a lambda or a nested
+function without one has no name that would change when it changes, and is refused where a
+definition must be exact (``exact=True``, the run keys).
 """
 
 from __future__ import annotations
@@ -32,11 +33,12 @@ import sys
 import types
 import typing
 from collections.abc import Callable, Mapping
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 
 from safepg.options import Adaptive, Batches, Departures, ErrorModel, FixedStep, Gradient, SafeStep, Target, Vanilla
+from safepg.tasks import Definition, FromDefinition, declares
 
 #: The option objects, by the name their dictionaries carry.
 OPTION_TYPES: dict[str, type] = {cls.__name__: cls for cls in (Adaptive, Vanilla, Gradient, ErrorModel, Batches,
@@ -124,7 +126,7 @@ def _annotations(cls: type) -> dict[str, Any]:
     does not evaluate (a name imported only for type checking) declares nothing.
     """
     raw: dict[str, tuple[Any, dict[str, Any]]] = {}
-    if dataclasses.is_dataclass(cls) and not hasattr(cls, "definition"):
+    if dataclasses.is_dataclass(cls) and Definition not in cls.__mro__:
         for klass in reversed(cls.__mro__):
             module = vars(sys.modules.get(klass.__module__, types.ModuleType("_")))
             for name, hint in vars(klass).get("__annotations__", {}).items():
@@ -220,7 +222,7 @@ def to_dict(value: Any, exact: bool = True) -> Any:
     if isinstance(value, Mapping):
         return {str(k): to_dict(v, exact) for k, v in sorted(value.items())}
     try:
-        if hasattr(value, "definition") and not isinstance(value, type):
+        if not isinstance(value, type) and declares(type(value), Definition, "definition"):
             fields = value.definition()
         elif dataclasses.is_dataclass(value) and not isinstance(value, type):
             fields = {f.name: getattr(value, f.name) for f in dataclasses.fields(value) if f.init}
@@ -256,8 +258,9 @@ def from_dict(data: Any) -> Any:
                            f"cannot be built again")
     cls = _type_of(data["type"])
     kwargs = {k: _field_value(v) for k, v in data.items() if k != "type"}
-    rebuild = getattr(cls, "from_definition", None)
-    return rebuild(**kwargs) if rebuild is not None else cls(**kwargs)
+    if declares(cls, FromDefinition, "from_definition"):
+        return cast(type[FromDefinition], cls).from_definition(**kwargs)  # declared: the class inherits it
+    return cls(**kwargs)
 
 
 def _field_value(data: Any) -> Any:

@@ -162,6 +162,25 @@ class PerformanceBatch(Protocol):
         ...
 
 
+class Definition(Protocol):
+    """A task written into its run's definition by the keywords ``definition()`` returns, instead of
+    by its dataclass fields (:func:`safepg.definition.to_dict`): a matrix written out, a factory by name."""
+
+    def definition(self) -> dict[str, Any]:
+        """The keyword arguments that make this task."""
+        ...
+
+
+class FromDefinition(Protocol):
+    """A task built again from the keywords of its definition by ``from_definition`` instead of by its
+    constructor (:func:`safepg.definition.from_dict`)."""
+
+    @classmethod
+    def from_definition(cls, **kwargs: Any) -> Any:
+        """The task the keywords of :meth:`Definition.definition` describe."""
+        ...
+
+
 #: The optional methods, by the Protocol that declares each.
 METHOD_HOOKS: dict[type, str] = {GradientBatch: "gradient_batch", GradientBatchConstants: "gradient_batch_constants",
                                  FixedStepBatches: "fixed_step_batches", MeasuredReturns: "measured_returns",
@@ -246,6 +265,28 @@ def constants_settings(task: object) -> ConstantsSettingValues:
     return ConstantsSettingValues(declared.horizon_term, declared.constants_gamma)
 
 
+def declares(cls: type, proto: type, name: str) -> bool:
+    """Whether ``cls`` declares the one-method Protocol ``proto`` (inherits it and defines ``name``).
+
+    Raises
+    ------
+    TypeError
+        ``cls`` declares ``proto`` without defining ``name``, defines ``name`` without declaring
+        ``proto`` (a hook that would otherwise be used, or skipped, in silence), or defines it
+        with other parameters than ``proto``.
+    """
+    declared = proto in cls.__mro__
+    method = getattr(cls, name, None)
+    if declared and (method is None or method is getattr(proto, name)):
+        raise TypeError(f"{cls.__name__} declares {proto.__name__} but does not define {name}")
+    if not declared and method is not None:
+        raise TypeError(f"{cls.__name__} defines {name} but does not declare safepg.tasks.{proto.__name__}: "
+                        f"inherit it so that it is used")
+    if declared:
+        _check_signature(cls, proto, name)
+    return declared
+
+
 def task_hooks(task: Task) -> Hooks:
     """Check ``task``'s declared fast paths and settings, and return the fast paths bound.
 
@@ -262,15 +303,7 @@ def task_hooks(task: Task) -> Hooks:
     _check_values(task)
     found: dict[str, Any] = {}
     for proto, name in METHOD_HOOKS.items():
-        declared = proto in cls.__mro__
-        method = getattr(cls, name, None)
-        if declared and (method is None or method is getattr(proto, name)):
-            raise TypeError(f"{cls.__name__} declares {proto.__name__} but does not define {name}")
-        if not declared and method is not None:
-            raise TypeError(f"{cls.__name__} defines {name} but does not declare safepg.tasks.{proto.__name__}: "
-                            f"inherit it so the learning loops use it")
-        if declared:
-            _check_signature(cls, proto, name)
+        if declares(cls, proto, name):
             found[name] = getattr(task, name)
     action_dim = 1
     if ActionDimension in cls.__mro__:
@@ -281,5 +314,6 @@ def task_hooks(task: Task) -> Hooks:
 
 
 __all__ = ["DEFAULT_CONSTANTS_SETTINGS", "METHOD_HOOKS", "VALUE_HOOKS", "ActionDimension", "BoundedTask",
-           "ConstantsSettingValues", "ConstantsSettings", "FixedStepBatches", "GradientBatch", "GradientBatchConstants",
-           "Hooks", "MeasuredReturns", "Performance", "PerformanceBatch", "Task", "constants_settings", "task_hooks"]
+           "ConstantsSettingValues", "ConstantsSettings", "Definition", "FixedStepBatches", "FromDefinition",
+           "GradientBatch", "GradientBatchConstants", "Hooks", "MeasuredReturns", "Performance", "PerformanceBatch",
+           "Task", "constants_settings", "declares", "task_hooks"]

@@ -338,3 +338,33 @@ def test_a_gym_task_declares_its_measured_returns():
         assert TaskConstants.from_task(task, 1.0).horizon_term == "horizon"
     finally:
         task.close()
+
+
+def test_a_definition_hook_is_used_only_where_declared():
+    """``definition()`` writes a task into its run's key only where the class declares it: a method of
+    that name left undeclared would silently decide (or not) what the key hashes."""
+    import dataclasses
+
+    from safepg.definition import from_dict, to_dict
+    from safepg.tasks import Definition
+
+    @dataclasses.dataclass(frozen=True)
+    class Undeclared:
+        gain: float = 1.0
+
+        def definition(self) -> dict[str, float]:
+            return {"gain": 2 * self.gain}
+
+    @dataclasses.dataclass(frozen=True)
+    class Declared(Definition):
+        gain: float = 1.0
+
+        def definition(self) -> dict[str, float]:
+            return {"gain": self.gain, "written": True}
+
+    with pytest.raises(TypeError, match="defines definition but does not declare safepg.tasks.Definition"):
+        to_dict(Undeclared())
+    assert to_dict(Declared(2))["gain"] == 2.0 and to_dict(Declared(2))["written"] is True
+    with pytest.raises(TypeError, match="declares Definition but does not define definition"):
+        to_dict(type("Half", (Definition,), {})())
+    assert to_dict(from_dict(to_dict(LQG(gamma=0.5)))) == to_dict(LQG(gamma=0.5))

@@ -34,7 +34,7 @@ from safepg import portable
 from safepg.constants import HORIZON_TERMS
 from safepg.policies import LinearGaussianPolicy
 from safepg.rng import RNGLike, as_generator
-from safepg.tasks import ActionDimension, ConstantsSettings, MeasuredReturns
+from safepg.tasks import ActionDimension, ConstantsSettings, Definition, FromDefinition, MeasuredReturns
 from safepg.trajectories import Trajectories
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -76,7 +76,7 @@ def _constant_missing(name: str, what: str) -> ValueError:
     )
 
 
-class GymTask(MeasuredReturns, ActionDimension, ConstantsSettings):
+class GymTask(MeasuredReturns, ActionDimension, ConstantsSettings, Definition, FromDefinition):
     r"""A gymnasium environment (``Box`` observations and actions) as a safe-PG task.
 
     ``simulate(policy, n, rng)`` runs n episodes of horizon H at once in a

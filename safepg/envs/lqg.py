@@ -28,7 +28,7 @@ from safepg.estimators import check_estimator, check_score_action
 from safepg.policies import LinearGaussianPolicy, check_sigma
 from safepg.rng import RNGLike, as_generator
 from safepg.streams import batch_key, trajectory_draws
-from safepg.tasks import ActionDimension, FixedStepBatches, GradientBatch, Performance, PerformanceBatch
+from safepg.tasks import ActionDimension, Definition, FixedStepBatches, GradientBatch, Performance, PerformanceBatch
 from safepg.trajectories import Trajectories
 
 
@@ -50,7 +50,7 @@ def _largest_eigenvalue(M: np.ndarray) -> float:
 
 
 @dataclass(frozen=True)
-class LQG(GradientBatch, FixedStepBatches, Performance, PerformanceBatch, ActionDimension):
+class LQG(GradientBatch, FixedStepBatches, Performance, PerformanceBatch, ActionDimension, Definition):
     """LQG regulation task with box-bounded states and actions.
 
     Parameters
