@@ -180,7 +180,7 @@ def figure51_52_overlay_series(records: Mapping[str, Sequence[LearningRecord]], 
                                           error.delta)]
     grid = curve["trajectories"].astype(np.int64)
     if processing == "text":
-        values, n = on_trajectories(records[config.name], grid), FIGURES_51_52_RUNS
+        values, n = on_trajectories(records[config.name], grid, "J"), FIGURES_51_52_RUNS
     else:
         mapped = [authors.grid_curve(r.batch_size, r.J[:-1]) for r in records[config.name]]
         if any(not np.array_equal(x, grid) for x, _ in mapped):

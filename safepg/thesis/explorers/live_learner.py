@@ -122,7 +122,7 @@ def _stored_run(cfg: Any, recs: Sequence[LearningRecord], grid: np.ndarray) -> d
             "delta": m.error.delta, "score": m.gradient.score_action, "seeds": len(recs), "name": cfg.name,
             "iteration": (keep + 1).tolist(), "start": _round(start_mean[keep]),
             "batch_size": _round(n[keep]), "alpha": _round(a[keep]),
-            "J": _round(mean_band(on_trajectories(recs, grid))[0]), "budgets": per_budget}
+            "J": _round(mean_band(on_trajectories(recs, grid, "J"))[0]), "budgets": per_budget}
 
 
 def _matches_1d_table(cfg: Any) -> bool:
@@ -365,7 +365,7 @@ def _compute_py(p: Mapping[str, Any], env: LQG, data: Mapping[str, Any],
         plots["alpha"]["series"].append({"x": (keep + 1).tolist(), "y": rec.alpha[keep].tolist(), **style})
         T = np.unique(np.maximum(1, np.round(1 + np.arange(data["points"]) * (budget - 1) / (data["points"] - 1))))
         T = T[T <= rec.trajectories].astype(np.int64)
-        plots["J"]["series"].append({"x": T.tolist(), "y": on_trajectories([rec], T)[0].tolist(), **style})
+        plots["J"]["series"].append({"x": T.tolist(), "y": on_trajectories([rec], T, "J")[0].tolist(), **style})
         values[name] = run_summary(rec, still_tolerance(data, float(rec.theta[0, 0])))
     return {"plots": plots, "values": values, "text": summary_text(values, data, budget)}
 
