@@ -279,6 +279,12 @@ class LearningRecord:
         except ValueError as err:
             raise RecordFileError(path, f"arrays that do not form one run ({err})") from err
         return rec
+def performance_field_of(records: Sequence[LearningRecord]) -> Performance:
+    """The performance several runs are read on together: ``"J"`` if every one has a closed form
+    (:attr:`LearningRecord.performance_field`), else the measured ``"J_hat"``, which every run has."""
+    return "J" if records and all(r.performance_field == "J" for r in records) else "J_hat"
+
+
 def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequence[int],
                     field: Performance | None = None) -> np.ndarray:
     """Several seeds' runs on one axis of trajectories: per run, ``field`` of the iteration whose
@@ -287,8 +293,8 @@ def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequen
     ``"J"`` is the thesis's "expected performance over sample trajectories" (Figures 5.1-5.2:
     each iteration's J held for all the trajectories of its batch); ``"J_hat"`` the batch's
     measured average return (Figure 5.9). Runs of different batch sizes thus line up, and
-    their mean or band over seeds can be taken column by column. None: the first record's
-    :attr:`~LearningRecord.performance_field`.
+    their mean or band over seeds can be taken column by column. None: the records' common
+    performance (:func:`safepg.record.performance_field_of`).
 
     Returns
     -------
@@ -296,7 +302,7 @@ def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequen
         NaN past a run's last trajectory.
     """
     grid = np.asarray(grid)
-    field = field or (records[0].performance_field if records else "J")
+    field = field or performance_field_of(records)
     out = np.full((len(records), grid.size), np.nan)
     for i, r in enumerate(records):
         idx = np.searchsorted(np.cumsum(r.batch_size), grid)
@@ -305,4 +311,4 @@ def on_trajectories(records: Sequence[LearningRecord], grid: np.ndarray | Sequen
     return out
 
 
-__all__ = ["CHECKPOINTS", "LearningRecord", "Performance", "RecordFileError", "on_trajectories"]
+__all__ = ["CHECKPOINTS", "LearningRecord", "Performance", "RecordFileError", "on_trajectories", "performance_field_of"]

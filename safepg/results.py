@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -26,25 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from safepg.record import LearningRecord, Performance, RecordFileError, on_trajectories
+from safepg.record import LearningRecord, Performance, RecordFileError, on_trajectories, performance_field_of
+from safepg.runner import run_file_seed, run_files
 from safepg.store import DamagedRunWarning
-
-_RUN_FILE = re.compile(r"^seed-(\d+)\.npz$")
-_KEY_DIR = re.compile(r"^[0-9a-f]{16}$")
 
 #: A folder's runs: the records of each configuration, by name, in the order of their seeds.
 Runs = Mapping[str, Sequence[LearningRecord]]
-
-
-def _run_files(name_dir: Path) -> list[tuple[str | None, Path]]:
-    """(the key its folder names, or None in the old layout; path) of each run file of one name."""
-    files: list[tuple[str | None, Path]] = []
-    for path in sorted(name_dir.iterdir()):
-        if path.is_dir() and _KEY_DIR.match(path.name):
-            files += [(path.name, p) for p in sorted(path.iterdir()) if _RUN_FILE.match(p.name)]
-        elif path.is_file() and _RUN_FILE.match(path.name):
-            files.append((None, path))
-    return files
 
 
 def load(folder: str | os.PathLike[str]) -> dict[str, list[LearningRecord]]:
@@ -67,7 +53,7 @@ def load(folder: str | os.PathLike[str]) -> dict[str, list[LearningRecord]]:
     out: dict[str, list[LearningRecord]] = {}
     for name_dir in sorted(p for p in root.iterdir() if p.is_dir()):
         by_key: dict[str, dict[int, LearningRecord]] = {}
-        for folder_key, path in _run_files(name_dir):
+        for folder_key, path in run_files(name_dir):
             try:
                 rec = LearningRecord.load(path)
             except RecordFileError as err:
@@ -77,24 +63,15 @@ def load(folder: str | os.PathLike[str]) -> dict[str, list[LearningRecord]]:
             if rec.interrupted or (folder_key is not None and key != folder_key):
                 continue
             # A run in its key's folder wins over the same seed of the old layout (listed after it).
-            by_key.setdefault(key, {}).setdefault(int(rec.config.get("seed", _seed(path))), rec)
+            by_key.setdefault(key, {}).setdefault(int(rec.config.get("seed", run_file_seed(path))), rec)
         for key, seeds in by_key.items():
             out[name_dir.name if len(by_key) == 1 else f"{name_dir.name}/{key}"] = [seeds[k] for k in sorted(seeds)]
     return out
 
 
-def _seed(path: Path) -> int:
-    m = _RUN_FILE.match(path.name)
-    assert m is not None  # only run files are listed
-    return int(m.group(1))
-
-
 def _field(runs: Runs, field: Performance | None) -> Performance:
-    """``field``, or the closed-form J if every run has one, else the measured J_hat."""
-    if field is not None:
-        return field
-    recs = [r for rs in runs.values() for r in rs]
-    return "J" if recs and all(r.performance_field == "J" for r in recs) else "J_hat"
+    """``field``, or the performance all the runs share (:func:`~safepg.record.performance_field_of`)."""
+    return field or performance_field_of([r for recs in runs.values() for r in recs])
 
 
 def _mean_sd(values: Sequence[float]) -> dict[str, float]:

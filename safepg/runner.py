@@ -188,9 +188,9 @@ def run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
 
     The definition's :meth:`~RunConfig.key` is part of the path, so a run of a changed
     definition is stored beside the runs of the old one, never over them (:func:`prune` removes
-    the runs no configuration asks for any longer). Before version 0.5 the path was
-    ``folder/<name>/seed-<seed>.npz`` (:func:`legacy_run_path`): such files are still read when
-    their key matches, and never written.
+    the runs no configuration asks for any longer). Folders written before the key was part of
+    the path hold ``folder/<name>/seed-<seed>.npz`` (:func:`legacy_run_path`): such files are
+    still read when their key matches, and never written.
     """
     return Path(folder) / cfg.name / cfg.key() / f"seed-{seed}.npz"
 
@@ -208,9 +208,11 @@ def stored_run(folder: str | os.PathLike[str], cfg: RunConfig, seed: int,
     was part of the path), where only a run of this very definition is accepted. A damaged file
     is handled as ``on_damaged`` says (:data:`safepg.store.OnDamaged`).
     """
-    rec = load_stored(run_path(folder, cfg, seed), cfg.key(), on_damaged)
-    if rec is None and not run_path(folder, cfg, seed).exists():
-        rec = load_stored(legacy_run_path(folder, cfg, seed), cfg.key(), on_damaged)
+    path = run_path(folder, cfg, seed)
+    key = path.parent.name  # the definition's hash, computed once
+    rec = load_stored(path, key, on_damaged)
+    if rec is None and not path.exists():
+        rec = load_stored(legacy_run_path(folder, cfg, seed), key, on_damaged)
     return rec
 
 
@@ -301,8 +303,32 @@ def load_configs(configs: Sequence[RunConfig], seeds: Seeds, folder: str | os.Pa
     return out
 
 
-_RUN_FILE = re.compile(r"^seed-\d+\.npz$")
+_RUN_FILE = re.compile(r"^seed-(\d+)\.npz$")
 _KEY_DIR = re.compile(r"^[0-9a-f]{16}$")
+
+
+def run_files(name_dir: Path) -> list[tuple[str | None, Path]]:
+    """Each run file stored under one configuration name's folder, with the key its folder names.
+
+    ``(key, <name_dir>/<key>/seed-<k>.npz)`` in the layout :func:`run_path` writes, and
+    ``(None, <name_dir>/seed-<k>.npz)`` in the old one (:func:`legacy_run_path`), whose key is
+    in the file. Only run files: damaged files set aside and temporary files are not listed.
+    """
+    files: list[tuple[str | None, Path]] = []
+    for path in sorted(name_dir.iterdir()):
+        if path.is_dir() and _KEY_DIR.match(path.name):
+            files += [(path.name, p) for p in sorted(path.iterdir()) if _RUN_FILE.match(p.name)]
+        elif path.is_file() and _RUN_FILE.match(path.name):
+            files.append((None, path))
+    return files
+
+
+def run_file_seed(path: Path) -> int:
+    """The seed a run file's name gives (``seed-<k>.npz``)."""
+    m = _RUN_FILE.match(path.name)
+    if m is None:
+        raise ValueError(f"path must name a run file seed-<k>.npz, got {path.name!r}")
+    return int(m.group(1))
 
 
 def _legacy_key(path: Path) -> str | None:
@@ -340,19 +366,17 @@ def prune(folder: str | os.PathLike[str], configs: Sequence[RunConfig], dry_run:
     root = Path(folder)
     for name_dir in sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else ():
         keys = asked.get(name_dir.name, set())
-        for path in sorted(name_dir.iterdir()):
-            if path.is_dir() and _KEY_DIR.match(path.name) and path.name not in keys:
-                removed += sorted(p for p in path.iterdir() if _RUN_FILE.match(p.name))
-            elif path.is_file() and _RUN_FILE.match(path.name):
-                stamped = _legacy_key(path)
-                if stamped is not None and stamped not in keys:
-                    removed.append(path)
+        for key, path in run_files(name_dir):
+            # An old-layout file's key is in the file; one that cannot be read stays (damaged, not stale).
+            stamped = key if key is not None else _legacy_key(path)
+            if stamped is not None and stamped not in keys:
+                removed.append(path)
     if not dry_run:
         for path in removed:
             path.unlink()
-        for key_dir in {p.parent for p in removed}:
-            if key_dir != root and not any(key_dir.iterdir()):
-                key_dir.rmdir()
+        for parent in {p.parent for p in removed}:
+            if not any(parent.iterdir()):
+                parent.rmdir()
     return removed
 
 
@@ -491,5 +515,5 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
 
 
 __all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "RunGroup", "Seeds", "check_names", "is_stored",
-           "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_groups", "run_path", "seeds_of",
-           "store_run", "stored_run"]
+           "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_file_seed", "run_files",
+           "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]
