@@ -79,8 +79,23 @@ def generator_rates(seconds: float = 1.0) -> dict[str, dict[str, float]]:
     n_streams, per = 200_000, 500
     t0 = time.perf_counter()
     streams.normal_rate_probe(np.uint64(2), n_streams, per)
-    out["safepg streams"] = {"normal": n_streams * per / (time.perf_counter() - t0)}
+    out["safepg streams, one by one"] = {"normal": n_streams * per / (time.perf_counter() - t0)}
+    floors = step_floors(repeat=3)
+    out["safepg streams"] = {"normal": floors["normals"]}
+    out["cart-pole bare step"] = {"step": floors["cart-pole bare step"]}
     return out
+
+
+def step_floors(repeat: int = 3) -> dict[str, float]:
+    """Per second on every core: normals as the kernels draw them (``draw_normals``, a chunk of streams
+    at a time) and the cart-pole's bare steps (``bench_step_floor.py``)."""
+    from bench_step_floor import STABLE, _cartpole_bare, _normals, bare_step_shape, best_ns_per_step
+
+    n, horizon, key = 32768, 200, np.uint64(12345)
+    shape = bare_step_shape()
+    return {"normals": 1e9 / best_ns_per_step(lambda: _normals(key, n, horizon), n * horizon, repeat),
+            "cart-pole bare step": 1e9 / best_ns_per_step(lambda: _cartpole_bare(key, n, horizon, STABLE, *shape),
+                                                          n * horizon, repeat)}
 
 
 def chapter_times(work: Path) -> dict[str, float]:
@@ -181,7 +196,10 @@ def main() -> None:
     rates = generator_rates()
     numpy_rates = {k: v for k, v in rates.items() if k.startswith("numpy")}
     fastest = max(numpy_rates, key=lambda k: numpy_rates[k]["normal"])
-    normal_rate = numpy_rates[fastest]["normal"]
+    # The floor: our streams' normals as the kernels draw them, measured in this run; the cart-pole's
+    # (learning runs and safety-mc) its bare steps, each a normal, a sine and a cosine.
+    normal_rate = rates["safepg streams"]["normal"]
+    step_rates = {"cartpole": rates["cart-pole bare step"]["step"]}
     uniform_rate = max(v["uniform"] for v in numpy_rates.values())
     work = args.results or args.keep or Path(tempfile.mkdtemp(prefix="safepg-book-")) / "clone"
     try:
@@ -189,7 +207,11 @@ def main() -> None:
         from safepg.thesis.budget import budget_rows, campaign, compile_seconds, markdown
 
         chapters = chapter_times(work)
-        budget = budget_rows(campaign(work / "results"), normal_rate, uniform_rate, chapters)
+        works = campaign(work / "results")
+        budget = budget_rows(works, normal_rate, uniform_rate, chapters, step_rates)
+        numpy_floor = budget_rows(works, numpy_rates[fastest]["normal"], uniform_rate)
+        for row, other in zip(budget["chapters"], numpy_floor["chapters"]):
+            row[f"ratio_{fastest.split()[-1]}"] = other["ratio"]
         out = {"date": time.strftime("%Y-%m-%d"), "cores": os.cpu_count(), "machine": machine(),
                "build_wall_s": None if phases is None else round(wall_seconds(phases), 1), "phases": phases,
                "venv_MB": None if phases is None else venv_megabytes(work),
@@ -197,7 +219,9 @@ def main() -> None:
                "notebook_execution_s": dict(sorted(chapters.items(), key=lambda kv: -kv[1])),
                "generators_per_s_all_cores": {k: {kk: float(f"{vv:.4g}") for kk, vv in v.items()}
                                               for k, v in rates.items()},
-               "floor_generator": fastest, "floor_normal_rate": float(f"{normal_rate:.4g}"),
+               "floor_generator": "safepg streams (draw_normals)", "floor_normal_rate": float(f"{normal_rate:.4g}"),
+               "floor_step_rates": {k: float(f"{v:.4g}") for k, v in step_rates.items()},
+               "fastest_numpy_generator": fastest,
                "floor_uniform_rate": float(f"{uniform_rate:.4g}"),
                # Part of run-book's time, in no experiment's: the kernels compiled once before them.
                "compile_once_s": compile_seconds(work / "results"), **budget}

@@ -105,6 +105,16 @@ def test_rows_floor_and_ratio() -> None:
     assert "| lqg1d | 15 |" in table and "| safety-mc | cartpole |" in table
 
 
+def test_a_chapter_s_floor_by_its_bare_step() -> None:
+    """With a bare step's rate, a chapter's floor is its steps at that rate (plus its uniforms); the
+    other chapters keep their normals' floor."""
+    works = [budget.Work("c", "cartpole", 10, 300, 300, 40, 6.0), budget.Work("a", "lqg1d", 10, 200, 200, 10, 4.0)]
+    out = budget.budget_rows(works, normal_rate=100.0, uniform_rate=10.0, step_rates={"cartpole": 50.0})
+    c, a = out["experiments"]
+    assert c["floor_s"] == pytest.approx(300 / 50 + 40 / 10) and c["ratio"] == pytest.approx(0.6)
+    assert a["floor_s"] == pytest.approx(200 / 100 + 10 / 10)
+
+
 def _notebook_names(chapter: str) -> list[str]:
     """The experiment names of the chapter's ``names = [...]`` cell."""
     cells = json.loads((ROOT / "book" / f"{chapter}.ipynb").read_text())["cells"]

@@ -53,10 +53,14 @@ class Work:
     uniforms: int | None
     seconds: float | None
 
-    def floor(self, normal_rate: float, uniform_rate: float) -> float | None:
-        """Seconds to draw the work's random numbers at the given rates (numbers per second)."""
+    def floor(self, normal_rate: float, uniform_rate: float, step_rate: float | None = None) -> float | None:
+        """Seconds to draw the work's random numbers at the given rates (numbers per second), or,
+        with ``step_rate`` (bare steps per second, each with its normal), to make its steps and
+        draw its uniforms."""
         if self.normals is None or self.uniforms is None:
             return None
+        if step_rate is not None and self.steps is not None:
+            return self.steps / step_rate + self.uniforms / uniform_rate
         return self.normals / normal_rate + self.uniforms / uniform_rate
 
 
@@ -178,19 +182,24 @@ def campaign(root: Path) -> list[Work]:
 
 
 def budget_rows(works: list[Work], normal_rate: float, uniform_rate: float,
-                chapter_seconds: Mapping[str, float] | None = None) -> dict[str, list[dict[str, Any]]]:
+                chapter_seconds: Mapping[str, float] | None = None,
+                step_rates: Mapping[str, float] | None = None) -> dict[str, list[dict[str, Any]]]:
     """Per experiment and per chapter: counts, floor, measured seconds and their ratio.
 
     A chapter's ``campaign_s`` is the sum of its computations' recorded times and its floor
     that of the computations whose random numbers are known, so its ratio errs high.
     ``chapter_seconds`` (the notebooks' execution times) adds each chapter's ``notebook_s``.
+    ``step_rates`` gives, by chapter, a bare step's rate (a step with its normal and nothing of an
+    estimator, e.g. the cart-pole's with its sine and cosine): that chapter's floor is its steps at
+    that rate instead of its normals at ``normal_rate``.
     """
+    step_rates = step_rates or {}
     def ratio(measured: float | None, floor: float | None) -> float | None:
         return None if measured is None or not floor else round(measured / floor, 2)
 
     rows = []
     for w in works:
-        floor = w.floor(normal_rate, uniform_rate)
+        floor = w.floor(normal_rate, uniform_rate, step_rates.get(w.chapter))
         rows.append({**asdict(w), "floor_s": None if floor is None else round(floor, 2),
                      "ratio": ratio(w.seconds, floor)})
     chapters = []
