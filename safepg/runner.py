@@ -50,6 +50,12 @@ from safepg.store import DamagedRunsError, OnDamaged, load_stored, remove_stale_
 #: seed stream (RunConfig.seed) changed.
 RESULTS_VERSION = "4"
 
+#: The version whose keys seed the runs, frozen at 4: seed k of a configuration draws from the stream
+#: of its definition's key at version 4 (:meth:`RunConfig.seed_key`), whatever RESULTS_VERSION becomes.
+#: A version bump therefore recomputes every run from the random numbers it had, and its numbers move
+#: only where the library's computation changed. (Up to version 4 a run's key and its seed key were one.)
+SEED_VERSION = "4"
+
 
 def make_env(name: str) -> Any:
     """Environment by name.
@@ -85,11 +91,13 @@ class RunConfig:
     of :func:`make_env`'s. ``stop_on_divergence`` ends a run whose gradient estimate is not
     finite and records it (``diverged``), instead of raising: a stored run is a result.
     ``warm_start`` names the run whose final parameters, seed by seed, start this one, and
-    ``warm_start_key`` is that run's :meth:`key`, so that a changed starting run changes this
-    run's key too. ``name`` only labels the run in its group's folder.
+    ``warm_start_key`` is that run's :meth:`seed_key`, so that a changed starting run changes
+    this run's key too. ``name`` only labels the run in its group's folder.
 
     :meth:`definition` writes all of it as one canonical dictionary (:mod:`safepg.definition`),
-    :meth:`from_definition` reads it back, and :meth:`key` hashes it.
+    :meth:`from_definition` reads it back, :meth:`key` hashes it with :data:`RESULTS_VERSION`
+    (where the store keeps the run) and :meth:`seed_key` with :data:`SEED_VERSION` (the run's
+    random numbers).
     """
 
     name: str
@@ -152,13 +160,18 @@ class RunConfig:
                    warm_start=warm_start, warm_start_key=d["warm_start"])
 
     def key(self) -> str:
-        """Hash of the :meth:`definition` (not of the name) and of :data:`RESULTS_VERSION`."""
-        blob = json.dumps([self.definition(), RESULTS_VERSION], sort_keys=True, allow_nan=False)
-        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+        """Hash of the :meth:`definition` (not of the name) and of :data:`RESULTS_VERSION`: the run's
+        place in the store, which a change of the library's numbers moves."""
+        return _definition_hash(self.definition(), RESULTS_VERSION)
+
+    def seed_key(self) -> str:
+        """Hash of the :meth:`definition` and of :data:`SEED_VERSION`: what seeds the run's streams
+        (:meth:`seed`), the same across versions of the results."""
+        return _definition_hash(self.definition(), SEED_VERSION)
 
     def seed(self, index: int) -> np.random.SeedSequence:
-        """Independent stream for seed ``index`` of this configuration."""
-        return np.random.SeedSequence([index, int(self.key(), 16) % 2**63])
+        """Independent stream for seed ``index`` of this configuration, from its :meth:`seed_key`."""
+        return np.random.SeedSequence([index, int(self.seed_key(), 16) % 2**63])
 
     def run(self, seed: int, progress: bool = False, theta0: np.ndarray | None = None) -> LearningRecord:
         """Run seed ``seed``.
@@ -181,6 +194,11 @@ class RunConfig:
                     stop_on_divergence=self.stop_on_divergence)
         rec.config.update(self.definition(exact=False))  # a warm start's theta0 is its start run's key
         return rec
+
+
+def _definition_hash(definition: dict[str, Any], version: str) -> str:
+    blob = json.dumps([definition, version], sort_keys=True, allow_nan=False)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
 def run_path(folder: str | os.PathLike[str], cfg: RunConfig, seed: int) -> Path:
@@ -514,6 +532,6 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
     return [load_configs(g.configs, g.seeds, g.folder, first_seed=g.first_seed) for g in groups]
 
 
-__all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "RunGroup", "Seeds", "check_names", "is_stored",
+__all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "SEED_VERSION", "RunGroup", "Seeds", "check_names", "is_stored",
            "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_file_seed", "run_files",
            "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]

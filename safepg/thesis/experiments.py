@@ -465,7 +465,7 @@ def _bind(exp: Experiment, registry: dict[str, Experiment]) -> Experiment:
     configs = []
     for c in exp.configs:
         if c.warm_start is not None:
-            c = replace(c, warm_start_key=registry[c.warm_start].single_config().key())
+            c = replace(c, warm_start_key=registry[c.warm_start].single_config().seed_key())
         configs.append(c)
     return replace(exp, configs=tuple(configs))
 

@@ -68,6 +68,9 @@ _BASELINE_CODES = {"none": 0, "optimal": 1, "average": 2}
 #: Bump when a change here alters the numbers a sweep run produces (stored sweeps are recomputed).
 #: 2: the counter-based streams of safepg.streams instead of NumPy's draws.
 SWEEP_VERSION = "2"
+#: The version whose hash seeds a sweep run, frozen at 2: a bump of SWEEP_VERSION recomputes the
+#: sweep from the same random numbers (as :data:`safepg.runner.SEED_VERSION` for the runs).
+SWEEP_SEED_VERSION = "2"
 
 
 @dataclass(frozen=True)
@@ -330,7 +333,7 @@ def cell_name(sigma: float, n: int, alpha: float) -> str:
 
 
 def _seed(variant: Variant, theta0: float, sigma: float, n: int, alpha: float, k: int) -> np.random.SeedSequence:
-    blob = json.dumps([asdict(variant), theta0, sigma, n, alpha, SWEEP_VERSION], sort_keys=True)
+    blob = json.dumps([asdict(variant), theta0, sigma, n, alpha, SWEEP_SEED_VERSION], sort_keys=True)
     return np.random.SeedSequence([k, int(hashlib.sha256(blob.encode()).hexdigest()[:15], 16)])
 
 
