@@ -7,7 +7,7 @@ multiply-add per component. Here the loop runs in numba around the fused serial 
 gives the bits of :func:`safepg.learning.vanilla_pg`'s loop (tested):
 
 * the gradient estimate ``samples.sum(axis=0) / n``: NumPy sums a column vector (m = 1) by
-  its pairwise summation (:func:`pairwise_sum`), and the columns of an (n, m >= 2) array
+  its pairwise summation (:func:`safepg.numpy_order.pairwise_sum`), and the columns of an (n, m >= 2) array
   row after row into zeros;
 * the batch's mean return ``returns.sum() / n``, pairwise;
 * the step ``theta + alpha * grad`` (``"scalar"``), or ``alpha * g_k`` added to the first
@@ -29,105 +29,7 @@ from safepg.envs._lqg_kernel import (
     lqg2d_gradient_samples_serial,
     lqg_gradient_samples_serial,
 )
-
-#: NumPy's pairwise summation: blocks of at most 128 terms, each summed with 8 accumulators.
-_BLOCK = 128
-_UNROLL = 8
-
-
-@njit(cache=True)
-def _block_sum(a, lo, n):  # pragma: no cover - numba
-    """NumPy's sum of a block of at most 128 terms: in order below 8, else 8 running sums."""
-    if n < _UNROLL:
-        res = 0.0
-        for i in range(n):
-            res += a[lo + i]
-        return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = _UNROLL
-    whole = n - n % _UNROLL
-    while i < whole:
-        j = lo + i
-        r0 += a[j]
-        r1 += a[j + 1]
-        r2 += a[j + 2]
-        r3 += a[j + 3]
-        r4 += a[j + 4]
-        r5 += a[j + 5]
-        r6 += a[j + 6]
-        r7 += a[j + 7]
-        i += _UNROLL
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < n:
-        res += a[lo + i]
-        i += 1
-    return res
-
-
-@njit(cache=True)
-def _pairwise(a, n):  # pragma: no cover - numba
-    """NumPy's recursion (a block, or the sum of the two halves, the first a multiple of 8 terms),
-    walked with an explicit stack: numba cannot load a cached recursive function."""
-    if n <= _BLOCK:
-        return _block_sum(a, 0, n)
-    depth = 64  # halving from 2^63 terms reaches a block in fewer levels
-    los = np.empty(depth, np.int64)
-    ns = np.empty(depth, np.int64)
-    phase = np.zeros(depth, np.int64)  # 0: left half to sum, 1: right half to sum, 2: both summed
-    left = np.empty(depth)
-    top, ret = 0, 0.0
-    los[0], ns[0] = 0, n
-    while top >= 0:
-        lo, size = los[top], ns[top]
-        if size <= _BLOCK:
-            ret = _block_sum(a, lo, size)
-            top -= 1
-            continue
-        half = size // 2
-        half -= half % _UNROLL
-        if phase[top] == 0:
-            phase[top] = 1
-            top += 1
-            los[top], ns[top], phase[top] = lo, half, 0
-        elif phase[top] == 1:
-            left[top] = ret
-            phase[top] = 2
-            top += 1
-            los[top], ns[top], phase[top] = lo + half, size - half, 0
-        else:
-            ret = left[top] + ret
-            top -= 1
-    return ret
-
-
-@njit(cache=True)
-def pairwise_sum(a):  # pragma: no cover - numba
-    """``a.sum()`` of a contiguous 1-D float array, in NumPy's order: 0.0 plus the pairwise sum."""
-    return 0.0 + _pairwise(a, a.size)
-
-
-@njit(cache=True)
-def column_means(samples, n):  # pragma: no cover - numba
-    m = samples.shape[1]
-    out = np.zeros(m)
-    if m == 1:
-        out[0] = pairwise_sum(np.ascontiguousarray(samples[:, 0]))
-    else:
-        for i in range(samples.shape[0]):
-            for j in range(m):
-                out[j] += samples[i, j]
-    for j in range(m):
-        out[j] = out[j] / n
-    return out
-
-
-@njit(cache=True)
-def _all_finite(x):  # pragma: no cover - numba
-    for v in x.ravel():
-        if not np.isfinite(v):
-            return False
-    return True
+from safepg.numpy_order import all_finite, column_means, pairwise_sum
 
 
 @njit(cache=True)
@@ -199,11 +101,11 @@ def _batches(theta, L, Pm, A, B, Q, R, keys, sizes, H, gamma, bs, ba, clip, scor
         grad = column_means(samples, n)
         _set_row(grads, i, grad)
         j_hat[i] = pairwise_sum(returns) / n
-        if not _all_finite(grad):
+        if not all_finite(grad):
             return thetas[:i + 1], grads[:i + 1], j_hat[:i + 1]
         theta = _step(theta, grad, alpha, coordinate)
         _set_row(thetas, i + 1, theta)
-        if not _all_finite(theta):
+        if not all_finite(theta):
             return thetas[:i + 2], grads[:i + 1], j_hat[:i + 1]
     return thetas, grads, j_hat
 
