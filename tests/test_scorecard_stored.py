@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
+import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -105,9 +108,11 @@ def test_a_theory_page_reads_the_stored_rows_and_else_derives_only_its_closed_fo
     """A chapter without runs takes its rows from the build's stored scorecard when there is one
     (the same rows: test_rows_of_some_pages_equal_the_full_cards_rows), else derives its closed
     forms alone; it never builds the whole card."""
+    from safepg.thesis.scorecard import closed_forms as closed_forms_module
+
     derived = []
-    closed_forms = rows_module.closed_form_rows
-    monkeypatch.setattr(rows_module, "closed_form_rows", lambda b: derived.append(1) or closed_forms(b))
+    closed_forms = closed_forms_module.closed_form_rows
+    monkeypatch.setattr(closed_forms_module, "closed_form_rows", lambda b: derived.append(1) or closed_forms(b))
     monkeypatch.setattr(rows_module, "_build", lambda *a, **k: pytest.fail("a theory page built the whole card"))
     alone = scorecard(root=tmp_path, pages=["errata"])
     assert alone and len(derived) == 1 and not (tmp_path / stored.FOLDER).exists()
@@ -116,3 +121,18 @@ def test_a_theory_page_reads_the_stored_rows_and_else_derives_only_its_closed_fo
     stored.stored_rows(tmp_path, rows_module.BOOK, lambda: marked)
     assert scorecard(root=tmp_path, pages=["errata"]) == marked and len(derived) == 1
     assert scorecard(root=tmp_path, pages=["errata"], store=False) == alone and len(derived) == 2
+
+
+def test_reading_the_stored_card_imports_no_sympy(tmp_path):
+    """A chapter's count sentence reads the stored rows: importing the scorecard and reading them loads
+    no sympy (3 s of every chapter's execution before); deriving the closed forms does."""
+    code = ("import sys; from pathlib import Path; from safepg.thesis import scorecard as sc; "
+            "from safepg.thesis.scorecard import stored; from safepg.thesis.scorecard.rows import BOOK; "
+            "sys.argv[2] == 'store' and stored.stored_rows(Path(sys.argv[1]), BOOK, lambda: []); "
+            "sc.counts_text(sc.scorecard(root=Path(sys.argv[1]), pages=['errata'])); "
+            "print('sympy' in sys.modules)")
+    run = lambda how: subprocess.run([sys.executable, "-c", code, str(tmp_path), how],  # noqa: E731
+                                     capture_output=True, text=True, check=True).stdout.strip()
+    assert run("store") == "False"
+    shutil.rmtree(tmp_path / stored.FOLDER)  # no stored card: the closed forms are derived, with sympy
+    assert run("derive") == "True"

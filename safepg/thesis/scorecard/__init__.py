@@ -47,7 +47,6 @@ Modules (their public names used outside the package are available here):
 from __future__ import annotations
 
 from safepg.thesis.curve_bands import CURVE_SHARE
-from safepg.thesis.scorecard.closed_forms import THEORY_LABELS
 from safepg.thesis.scorecard.export import (
     CSV_COLUMNS,
     TABLES,

@@ -11,7 +11,6 @@ from safepg.thesis.experiment_store import load_experiment, run_experiment
 from safepg.thesis.experiments import EXPERIMENTS, Experiment, get_experiment
 from safepg.thesis.report import report
 from safepg.thesis.scorecard.builder import Builder
-from safepg.thesis.scorecard.closed_forms import closed_form_rows
 from safepg.thesis.scorecard.curves import curve_rows
 from safepg.thesis.scorecard.links import BOOK
 from safepg.thesis.scorecard.rules import GROUPS, Row
@@ -87,6 +86,8 @@ def scorecard(root: Path | None = None, *, run: bool = False, experiments: Mappi
         # closed forms with sympy about 3 s); otherwise the closed forms alone, reading no run.
         rows = rows_if_stored(base, BOOK) if shared else None
         if rows is None:
+            from safepg.thesis.scorecard.closed_forms import closed_form_rows  # sympy: 3 s to import
+
             b = Builder(book=book or BOOK)
             closed_form_rows(b)
             rows = b.rows
@@ -132,6 +133,8 @@ def _build(root: Path | None, run: bool, experiments: Mapping[str, Experiment] |
             exps[n] = overrides.get(n) or get_experiment(n)
             recs[n] = load_experiment(exps[n], root)
     reps = {n: report(e, recs[n]) for n, e in exps.items()}
+
+    from safepg.thesis.scorecard.closed_forms import closed_form_rows  # sympy: 3 s to import
 
     b = Builder(book=book)
     closed_form_rows(b)

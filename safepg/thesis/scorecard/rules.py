@@ -539,3 +539,33 @@ class Row:
         if unknown:
             raise ValueError(f"d has unknown keys {sorted(unknown)}")
         return cls(**dict(d))
+
+
+#: Short names of the statements of :mod:`safepg.thesis.errata` (display only; a new record falls
+#: back to its id).
+THEORY_LABELS = {
+    "thm_4_2_3_c": "penalty constant c", "cor_4_2_4_alpha": "step size 1/(2c)",
+    "cor_4_2_4_improvement": "guaranteed improvement", "cor_4_2_5_scalar_step": "scalar step of Pirotta et al. (2013)",
+    "cor_4_2_5_inequality": "coordinate step never worse than scalar", "cor_4_2_8_alpha": "step size with error ε",
+    "cor_4_2_8_improvement": "guaranteed improvement with error ε", "sec_4_2_2_selection": "choice of k",
+    "cor_4_2_8_actual_update": "guarantee for the update actually made", "thm_4_3_2_N0": "N₀",
+    "thm_4_3_2_N_star": "batch size N*", "thm_4_3_2_alpha": "step size α*", "thm_4_3_2_N_star_feasible": "N* ≥ N₀",
+    "fig_4_1_shape": "shape of Υ(N) (Figure 4.1)", "chebyshev_d": "Chebyshev d_δ",
+    "chebyshev_N_star_reinforce": "Chebyshev N*, REINFORCE", "chebyshev_N_star_gpomdp": "Chebyshev N*, G(PO)MDP",
+    "hoeffding_d": "Hoeffding d_δ", "bernstein_d_f": "Bernstein d_δ and f_δ", "bernstein_S_N": "sample variance S_N",
+    "bernstein_N0": "Bernstein N₀", "bernstein_factors": "factors of dΥ/dN", "bernstein_descartes": "unique maximum",
+    "scalar_step_3_3_2": "scalar step α* of Pirotta et al. (2013)",
+    "scalar_improvement_3_3_2": "improvement of Pirotta et al. (2013)",
+    "bound_3_7": "bound (3.7)", "lemma_a_0_1_hessian": "Gaussian second derivative",
+    "lemma_a_0_1_statement": "Lemma A.0.1", "lemma_a_0_2_statement": "Lemma A.0.2",
+    "lemma_b_0_3": "softmax second derivative", "lemma_b_0_5": "softmax policy distance",
+    "thm_b_0_6_c": "constant c", "thm_b_0_6_b": "constant b", "cor_b_0_7_alpha": "step size",
+    "cor_b_0_7_improvement": "guaranteed improvement", "thm_4_3_2_upsilon_proof": "Υ(Λ*, N) in the proof",
+    "thm_4_3_2_upsilon_star": "Υ*", "thm_4_3_2_improvement": "guaranteed improvement N* Υ*",
+    "hoeffding_exponent": "Hoeffding's tail", "range_definition": "range R of the gradient samples",
+    "lemma_4_3_3_range": "bound on the range R", "algorithm_4_1_step_line": "Algorithm 4.1, step line",
+    "algorithm_4_1_stopping": "Algorithm 4.1, stopping test",
+    "algorithm_4_1_min_batch": "Algorithm 4.1, smallest batch",
+    "lemma_4_2_2_q_sign": "sign of the Q term", "thm_4_2_6_probability": "confidence (1 - δ)^m",
+    "scalar_step_5_2_1": "scalar step α̂* as printed in 5.2.1",
+}

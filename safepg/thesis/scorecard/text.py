@@ -4,12 +4,9 @@ from __future__ import annotations
 
 import re
 import string
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
-
-import sympy as sp
-
-from safepg import theory
 
 
 def pct(x: float | None, digits: int = 2) -> str:
@@ -34,9 +31,17 @@ def signed(x: float, decimals: int) -> str:
     return f"{x:+.{decimals}f}"
 
 
+def _is_sympy(e: Any) -> bool:
+    """Whether ``e`` is a sympy expression, without importing sympy (3 s) where nothing made one."""
+    sp = sys.modules.get("sympy")
+    return sp is not None and isinstance(e, sp.Basic)
+
+
 def expr_text(e: Any) -> str:
     """Plain-text form of a printed or derived statement (sympy or LaTeX string)."""
-    if isinstance(e, sp.Basic):
+    if _is_sympy(e):
+        import sympy as sp
+
         s = sp.sstr(e)
         s = re.sub(r"sqrt\((\w+)\)", r"√\1", s)
         return s.replace("**", "^").replace("*", "·")
@@ -45,7 +50,9 @@ def expr_text(e: Any) -> str:
 
 def expr_tex(e: Any) -> str:
     """LaTeX of a statement; "" for a plain-text one (a string without a backslash)."""
-    if isinstance(e, sp.Basic):
+    if _is_sympy(e):
+        from safepg import theory
+
         return theory.latex(e)
     return str(e) if "\\" in str(e) else ""
 
