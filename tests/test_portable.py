@@ -6,10 +6,11 @@ Two kinds of evidence, without touching the machine's BLAS settings:
   an explicit loop over Python floats) bit for bit, on many random inputs; a source scan
   finds no ``@``, ``np.dot``, ``np.linalg``, ``scipy.linalg`` or ``scipy.stats`` on an
   output path except the listed, justified ones.
-- **By experiment.** Short learning runs recomputed in subprocesses on the host CPU, with
-  numba compiling for a generic x86-64 (``NUMBA_CPU_NAME=generic``), and additionally with
-  glibc's libm and NumPy's dispatch restricted to their pre-AVX2, pre-FMA code, give
-  bit-identical records and reports.
+- **By experiment.** Short learning runs recomputed in subprocesses give bit-identical records
+  and reports on the host CPU (AVX-512 where it has it), with numba compiling for AVX2
+  (``NUMBA_CPU_NAME=haswell``) and NumPy kept to its AVX2 loops, and with numba compiling for a
+  generic x86-64 and glibc's libm and NumPy's dispatch restricted to their pre-AVX2, pre-FMA
+  code. The AVX2 probe is the machine without AVX-512, measured on this one.
 """
 
 from __future__ import annotations
@@ -294,11 +295,15 @@ def test_source_scan_can_fail(tmp_path: Path) -> None:
 
 
 # -------------------------------------------------------------- by experiment
-def _probe(env: dict[str, str], cache: Path) -> subprocess.Popen:
+def _probe(env: dict[str, str], cache: Path | None) -> subprocess.Popen:
+    """The probe in a subprocess under ``env``; ``cache``: a fresh numba cache (every kernel compiled for this
+    CPU setting), None: the suite's own (the host's kernels, already compiled)."""
     full = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CPU_NAME", "GLIBC_TUNABLES",
                                                             "NPY_DISABLE_CPU_FEATURES")}
-    # A fresh cache: every kernel compiled for this CPU setting. One thread each: three probes share the cores.
-    full.update(env, NUMBA_CACHE_DIR=str(cache), NUMBA_NUM_THREADS="1")
+    # One thread each: the probes share the cores.
+    full.update(env, NUMBA_NUM_THREADS="1")
+    if cache is not None:
+        full["NUMBA_CACHE_DIR"] = str(cache)
     return subprocess.Popen([sys.executable, str(ROOT / "tests" / "portable_probe.py")], env=full, cwd=ROOT,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
@@ -309,18 +314,42 @@ def _result(proc: subprocess.Popen) -> dict:
     return json.loads(out)
 
 
+def numpy_above_avx2() -> list[str]:
+    """NumPy's dispatched features above AVX2 (x86-64-v3) that this CPU has: what NPY_DISABLE_CPU_FEATURES
+    must name to keep NumPy to its AVX2 loops (naming a feature the CPU lacks is refused)."""
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    return [f for f in __cpu_dispatch__ if __cpu_features__.get(f) and (f.startswith("AVX512") or f == "X86_V4")]
+
+
 @pytest.mark.slow
 def test_runs_are_bit_identical_across_cpu_settings(tmp_path: Path) -> None:
-    procs = [_probe({}, tmp_path / "host"), _probe({"NUMBA_CPU_NAME": "generic"}, tmp_path / "generic"),
+    """Host, AVX2 and pre-AVX2: the same bits. (A probe compiled for a generic x86-64 alone is not run: the
+    pre-AVX2 probe compiles for it too and also changes libm and NumPy, so it differs from the host in more.)"""
+    avx2 = {"NUMBA_CPU_NAME": "haswell"}
+    if numpy_above_avx2():
+        avx2["NPY_DISABLE_CPU_FEATURES"] = " ".join(numpy_above_avx2())
+    procs = [_probe({}, None), _probe(avx2, tmp_path / "avx2"),
              # As on a CPU without AVX2 and FMA: glibc's plain-SSE2 libm and NumPy's baseline loops.
              _probe({"NUMBA_CPU_NAME": "generic", "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX",
-                     "NPY_DISABLE_CPU_FEATURES": "X86_V3"}, tmp_path / "old")]
-    host, generic, old_cpu = (_result(p) for p in procs)
+                     "NPY_DISABLE_CPU_FEATURES": " ".join(["X86_V3", *numpy_above_avx2()])}, tmp_path / "old")]
+    host, avx2_cpu, old_cpu = (_result(p) for p in procs)
     assert set(host) >= {"1d-bernstein-er", "2d-scalar-step", "cartpole-adaptive", "pendulum-adaptive",
                          "pendulum-vanilla", "pendulum-returns", "closed-forms", "significance"}
     for name in host:
-        assert generic[name] == host[name], f"{name} differs with NUMBA_CPU_NAME=generic"
-        assert old_cpu[name] == host[name], f"{name} differs with a pre-AVX2 libm and NumPy"
+        assert avx2_cpu[name] == host[name], f"{name} differs between AVX2 code (NUMBA_CPU_NAME=haswell) and the host's"
+        assert old_cpu[name] == host[name], f"{name} differs with generic x86-64 code and a pre-AVX2 libm and NumPy"
+
+
+def test_the_avx2_probe_keeps_numpy_to_avx2() -> None:
+    """The AVX2 probe's NumPy dispatches to no loop above AVX2 (a subprocess with the probe's setting; in this
+    process, on an AVX-512 host, the same check finds X86_V4)."""
+    names = numpy_above_avx2()
+    env = {**os.environ, "NPY_DISABLE_CPU_FEATURES": " ".join(names)} if names else dict(os.environ)
+    code = ("from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; "
+            "print(sorted(k for k in d if f.get(k) and (k.startswith('AVX512') or k == 'X86_V4')))")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
 
 
 def test_small_angles_skip_the_reduction_with_the_same_bits() -> None:
