@@ -532,6 +532,6 @@ def run_groups(groups: Sequence[RunGroup], jobs: int = -1, progress: bool = True
     return [load_configs(g.configs, g.seeds, g.folder, first_seed=g.first_seed) for g in groups]
 
 
-__all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "SEED_VERSION", "RunGroup", "Seeds", "check_names", "is_stored",
-           "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_file_seed", "run_files",
-           "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]
+__all__ = ["OnComputed", "RESULTS_VERSION", "RunConfig", "RunGroup", "SEED_VERSION", "Seeds", "check_names",
+           "is_stored", "legacy_run_path", "load_configs", "make_env", "prune", "run_configs", "run_file_seed",
+           "run_files", "run_groups", "run_path", "seeds_of", "store_run", "stored_run"]

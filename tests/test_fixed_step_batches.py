@@ -12,9 +12,9 @@ import pytest
 
 from safepg import learning
 from safepg.envs._lqg_fixed_step import FIXED_STEP_BATCHES
-from safepg.numpy_order import column_means, pairwise_sum
 from safepg.envs.lqg import LQG
 from safepg.learning import LearningRecord, vanilla_pg
+from safepg.numpy_order import column_means, pairwise_sum
 from safepg.options import FixedStep, Gradient
 from safepg.policies import LinearGaussianPolicy
 from safepg.streams import batch_key, batch_keys

@@ -38,7 +38,7 @@ def test_the_variance_check_can_fail() -> None:
     rng = np.random.default_rng(3)
     x = wide(rng, 4099)
     mean = sum(x.tolist()) / x.size
-    sequential = sum(((v - mean) ** 2 for v in x.tolist())) / (x.size - 1)
+    sequential = sum((v - mean) ** 2 for v in x.tolist()) / (x.size - 1)
     assert sequential != np.var(x, ddof=1)
 
 

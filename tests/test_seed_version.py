@@ -16,6 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+
 import safepg.runner as runner
 import safepg.thesis.table51_sweep as sweep
 from safepg.options import Adaptive, Batches
@@ -34,7 +35,8 @@ def test_every_config_seeds_from_its_version_4_key():
 def test_a_bump_moves_the_store_not_the_seeds(monkeypatch):
     """Under another RESULTS_VERSION every key changes and no seed does, warm starts included (their
     definition names the seed key of the run they start from)."""
-    before = {n: {c.name: (c.key(), c.seed_key(), c.seed(3).entropy) for c in e.configs} for n, e in EXPERIMENTS.items()}
+    before = {n: {c.name: (c.key(), c.seed_key(), c.seed(3).entropy) for c in e.configs}
+              for n, e in EXPERIMENTS.items()}
     monkeypatch.setattr(runner, "RESULTS_VERSION", "bumped")
     after = _registry()  # built again: the warm starts' keys are bound at build time
     assert sorted(after) == sorted(before)
