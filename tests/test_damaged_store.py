@@ -178,10 +178,13 @@ def test_readers_leave_damaged_files_out_and_in_place(root):
 
 
 def test_stale_files_are_recomputed_silently(root, monkeypatch):
-    """Another RESULTS_VERSION (or other settings) is not damage: overwritten, nothing set aside."""
+    """Another RESULTS_VERSION (or other settings) is not damage: the run is computed again into its own key's
+    folder, the stale file stays where it was, nothing is set aside. The seeds do not follow the version
+    (RunConfig.seed_key): with the same code the recomputed run has the stale one's bits."""
     exp = small(seeds=1)
     monkeypatch.setattr(runner, "RESULTS_VERSION", "0")
     old = es.run_experiment(exp, jobs=1, progress=False)
+    old_keys = {c.name: c.key() for c in exp.configs}
     monkeypatch.undo()
     monkeypatch.setenv("SAFEPG_RESULTS", str(root))
     with warnings.catch_warnings():
@@ -189,8 +192,12 @@ def test_stale_files_are_recomputed_silently(root, monkeypatch):
         assert es.load_experiment(exp) == {c.name: [] for c in exp.configs}
         new = es.run_experiment(exp, jobs=1, progress=False)
     assert not list(root.rglob(f"*{store.DAMAGED_SUFFIX}*"))
-    assert all(len(new[c.name]) == 1 for c in exp.configs)
-    assert not np.array_equal(old[exp.configs[0].name][0].theta, new[exp.configs[0].name][0].theta)
+    for c in exp.configs:
+        assert len(new[c.name]) == 1 and c.key() != old_keys[c.name]
+        assert new[c.name][0].config["run_key"] == c.key() and old[c.name][0].config["run_key"] == old_keys[c.name]
+        stored_keys = sorted(p.parent.name for p in root.rglob(f"{c.name}/*/seed-0.npz"))
+        assert stored_keys == sorted([c.key(), old_keys[c.name]])
+        assert np.array_equal(old[c.name][0].theta, new[c.name][0].theta)
 
 
 def test_set_aside_leaves_a_file_another_runner_already_replaced(tmp_path):
