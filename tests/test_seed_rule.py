@@ -4,13 +4,14 @@ does not reproduce, and a campaign that depends on the runs alone, not on the fo
 from __future__ import annotations
 
 import io
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from safepg.thesis.experiment_store import Campaign, read_campaign, write_campaign
 from safepg.thesis.experiments import get_experiment
-from safepg.thesis.seed_rule import SEED_CAP, START_SEEDS, added, plan_seeds, wanted_seeds
+from safepg.thesis.seed_rule import MEMO, SEED_CAP, START_SEEDS, added, plan_seeds, rule_inputs_key, wanted_seeds
 
 OURS = "table-5.1-authors/sigma=0.5-N=1000-alpha=1e-05"
 THEIRS = "table-5.4/adaptive"
@@ -52,17 +53,21 @@ def test_the_authors_column_asks_only_where_ours_does_not_reproduce() -> None:
     assert wanted_seeds([row])[THEIRS] == START_SEEDS["one run"]
 
 
-def _plan(root: Path, needed: dict[int, int | None]) -> tuple[Campaign, list[list[str]]]:
-    """plan_seeds with a scorecard whose one row needs ``needed[seeds it has]`` seeds, and no runs."""
+def _plan(root: Path, needed: dict[int, int | None], remember: bool = False,
+          builds: list[Path] | None = None) -> tuple[Campaign, list[list[str]]]:
+    """plan_seeds with a scorecard whose one row needs ``needed[seeds it has]`` seeds, and no runs; each
+    build of the rows is appended to ``builds``."""
     calls: list[list[str]] = []
 
     def build(folder: Path) -> list[Any]:
+        if builds is not None:
+            builds.append(folder)
         return [FakeRow(seeds_needed=needed.get(_seeds(folder, OURS)))]
 
     def run(names: list[str], folder: Path, jobs: int) -> None:
         calls.append(names)
 
-    return plan_seeds(root, build, run=run, stream=io.StringIO()), calls
+    return plan_seeds(root, build, run=run, stream=io.StringIO(), remember=remember), calls
 
 
 def test_the_rule_adds_blocks_until_nothing_more_is_asked(tmp_path: Path) -> None:
@@ -90,3 +95,56 @@ def test_the_campaign_is_the_rule_s_whatever_the_folder_held_before(tmp_path: Pa
     write_campaign(Campaign(1_000_000, {cfg[STALE]: 10}), draw)
     campaign, _ = _plan(draw, {5: None})
     assert campaign == Campaign(1_000_000, {})
+
+
+def test_a_remembered_rule_builds_no_row_until_a_run_or_the_campaign_changes(tmp_path: Path) -> None:
+    """With ``remember``, a folder whose runs, campaign and code are as the rule left them keeps its campaign
+    without a row built; a run written again, a new run, or another campaign makes the rule run again, and
+    a file outside the experiments' folders (the sweep's, written after the rule) does not."""
+    run_file = tmp_path / OURS.split("/")[0] / "some-config" / "seed-0.npz"
+    run_file.parent.mkdir(parents=True)
+    run_file.write_bytes(b"a run")
+    builds: list[Path] = []
+    first, _ = _plan(tmp_path, {5: 10, 10: None}, remember=True, builds=builds)
+    assert len(builds) == 2 and (tmp_path / MEMO).read_text(encoding="utf-8") == rule_inputs_key(tmp_path)
+
+    builds.clear()
+    again, calls = _plan(tmp_path, {5: 10, 10: None}, remember=True, builds=builds)
+    assert (again, builds, calls) == (first, [], [])
+
+    (tmp_path / "table-5.1-sweep").mkdir()
+    (tmp_path / "table-5.1-sweep" / "sweep.npz").write_bytes(b"not read by the rows")
+    _plan(tmp_path, {5: 10, 10: None}, remember=True, builds=builds)
+    assert builds == []
+
+    # without remember, the memo is neither read nor written
+    _plan(tmp_path, {5: 10, 10: None}, builds=builds)
+    assert len(builds) == 2
+    key = (tmp_path / MEMO).read_text(encoding="utf-8")
+
+    changes = [
+        lambda: os.utime(run_file, ns=(1, run_file.stat().st_mtime_ns + 1_000_000)),  # written again
+        lambda: run_file.with_name("seed-1.npz").write_bytes(b"another run"),
+        lambda: write_campaign(Campaign(0, {"not-a-config": 7}), tmp_path),
+    ]
+    for change in changes:
+        change()
+        assert rule_inputs_key(tmp_path) != key
+        builds.clear()
+        campaign, _ = _plan(tmp_path, {5: 10, 10: None}, remember=True, builds=builds)
+        assert campaign == first and len(builds) == 2
+        key = (tmp_path / MEMO).read_text(encoding="utf-8")
+
+
+def test_the_rule_s_key_sees_the_package(tmp_path: Path, monkeypatch: Any) -> None:
+    """Another file in the package (code changed on disk) gives another key."""
+    import safepg.thesis.scorecard.stored as stored
+
+    package = tmp_path / "package"
+    package.mkdir()
+    (package / "rule.py").write_text("SEED_CAP = 20\n")
+    monkeypatch.setattr(stored, "PACKAGE", package)
+    key = rule_inputs_key(tmp_path)
+    assert rule_inputs_key(tmp_path) == key
+    (package / "rule.py").write_text("SEED_CAP = 30\n")
+    assert rule_inputs_key(tmp_path) != key

@@ -443,7 +443,8 @@ def _scorecard_tasks(tasks: list[Task]) -> bool:
 
 def _apply_seed_rule(root: Path, jobs: int, book: Path, kw: dict[str, Any]) -> None:
     """:func:`safepg.thesis.seed_rule.plan_seeds` on the scorecard's rows, its runs computed like the
-    chapters' experiments (progress, a line as each is done)."""
+    chapters' experiments (progress, a line as each is done); remembered, so that a build whose runs and code
+    did not change builds no row here."""
     from safepg.thesis.scorecard.rows import build_rows
     from safepg.thesis.seed_rule import plan_seeds
 
@@ -454,7 +455,7 @@ def _apply_seed_rule(root: Path, jobs: int, book: Path, kw: dict[str, Any]) -> N
         prefetch_experiments([Task("scorecard", name) for name in names], folder, jobs=n, **kw)
 
     campaign = plan_seeds(root, lambda folder: build_rows(folder, book), jobs, run=run,
-                          stream=cast(TextIO, _Prefixed(stream)))
+                          stream=cast(TextIO, _Prefixed(stream)), remember=True)
     _say(stream, f"seed rule: {len(campaign.seeds)} configurations beyond their experiment's seeds, in "
                  f"{duration(time.monotonic() - started)}")
 

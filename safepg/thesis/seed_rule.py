@@ -13,19 +13,30 @@ it rejects. The authors' settings' column asks only where ours does not reproduc
 
 :func:`plan_seeds` applies the rule to a results folder until nothing more is asked (the
 extra seeds go to the folder's :class:`~safepg.thesis.experiment_store.Campaign`); ``run-book`` calls
-it after the chapters' experiments.
+it after the chapters' experiments. The campaign is a function of the stored runs and the code alone, so
+``run-book`` lets it remember the state of its inputs (:func:`rule_inputs_key`) and, when nothing among them
+changed since it last ran, keeps the campaign it left instead of building the scorecard's rows again.
 """
 
 from __future__ import annotations
 
+import hashlib
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TextIO
 
-from safepg.thesis.experiment_store import Campaign, read_campaign, run_experiments, write_campaign
+from safepg.thesis.experiment_store import (
+    CAMPAIGN_FILE,
+    Campaign,
+    experiment_folder,
+    read_campaign,
+    run_experiments,
+    write_campaign,
+)
 from safepg.thesis.experiments import CURVE_SEEDS, EXPERIMENTS, get_experiment
 from safepg.thesis.scorecard.rules import Row
+from safepg.thesis.scorecard.stored import FOLDER, hash_package
 from safepg.thesis.scorecard.verdicts import RANDOM_KINDS, SEED_BLOCK
 
 #: The seeds a configuration starts with, by the kind of row it feeds (the most of its rows').
@@ -97,9 +108,35 @@ def added(campaign: Campaign) -> dict[str, int]:
     return out
 
 
+#: Where :func:`plan_seeds` remembers, inside a results folder, the key of the inputs it last left the campaign
+#: for (beside the stored scorecard, which is not among the rule's inputs).
+MEMO = Path(FOLDER) / "seed-rule.key"
+
+
+def rule_inputs_key(root: Path) -> str:
+    """SHA-256 (hex) of what the rule's campaign depends on in ``root``: every experiment's run files (path,
+    size and modification time: a run written again is another input), the campaign file's bytes and the
+    package's files (the rule, the scorecard's tests and the authors' data).
+
+    The other folders of ``root`` (the sweep, the safety measurements, the false alarms, comparisons) are
+    not read by the scorecard's rows, so they are left out: ``run-book`` writes them after the rule.
+    """
+    h = hashlib.sha256()
+    for name in sorted(EXPERIMENTS):
+        folder = experiment_folder(name, root)
+        for p in sorted(folder.rglob("*")) if folder.is_dir() else ():
+            if p.is_file():
+                st = p.stat()
+                h.update(f"run {p.relative_to(root).as_posix()} {st.st_size} {st.st_mtime_ns}\n".encode())
+    campaign = root / CAMPAIGN_FILE
+    h.update(b"campaign " + (campaign.read_bytes() if campaign.is_file() else b"none") + b"\n")
+    hash_package(h)
+    return h.hexdigest()
+
+
 def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -1, rounds: int = 6,
                run: Callable[[list[str], Path, int], object] | None = None,
-               stream: TextIO | None = None) -> Campaign:
+               stream: TextIO | None = None, remember: bool = False) -> Campaign:
     """Apply the rule to the results folder ``root`` until no column asks for more seeds.
 
     The rule starts from the starting counts whatever the folder's campaign says, so the campaign it
@@ -123,6 +160,11 @@ def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -
         :func:`~safepg.thesis.experiment_store.run_experiments`).
     stream : text stream, optional
         Where each round's additions are said (default stdout).
+    remember : bool
+        Store the key of the inputs the rule leaves (:func:`rule_inputs_key`, in :data:`MEMO`) and, when the
+        folder's inputs still have that key, return its campaign without building any row: the rule on the
+        same runs and code gives the same campaign. What the key cannot see is a ``build`` other than the
+        package's scorecard, or code changed in memory: leave it False then.
 
     Returns
     -------
@@ -130,6 +172,21 @@ def plan_seeds(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int = -
         The folder's campaign once the rule asks for nothing more.
     """
     stream = stream or sys.stdout
+    memo = root / MEMO
+    if remember and memo.is_file() and memo.read_text(encoding="utf-8") == rule_inputs_key(root):
+        print("seed rule: no run and no code changed since it was last applied: its campaign stands",
+              file=stream, flush=True)
+        return read_campaign(root)
+    campaign = _apply(root, build, jobs, rounds, run, stream)
+    if remember:
+        memo.parent.mkdir(parents=True, exist_ok=True)
+        memo.write_text(rule_inputs_key(root), encoding="utf-8")
+    return campaign
+
+
+def _apply(root: Path, build: Callable[[Path], Sequence[Row]], jobs: int, rounds: int,
+           run: Callable[[list[str], Path, int], object] | None, stream: TextIO) -> Campaign:
+    """The rounds of :func:`plan_seeds`."""
     run = run or (lambda names, folder, n: run_experiments(names, jobs=n, root=folder, progress=False))
     campaign = Campaign(read_campaign(root).first_seed, {})
     if read_campaign(root) != campaign:
@@ -159,5 +216,5 @@ def seed_table(campaign: Campaign) -> list[Mapping[str, object]]:
     return out
 
 
-__all__ = ["SEED_CAP", "SEED_RULE", "START_SEEDS", "added", "plan_seeds", "planned_campaign", "seed_table",
-           "wanted_seeds"]
+__all__ = ["MEMO", "SEED_CAP", "SEED_RULE", "START_SEEDS", "added", "plan_seeds", "planned_campaign",
+           "rule_inputs_key", "seed_table", "wanted_seeds"]

@@ -38,13 +38,18 @@ def inputs_key(root: Path, book: Path) -> str:
             if rel.parts[0] != FOLDER and p.is_file():
                 st = p.stat()
                 h.update(f"run {rel.as_posix()} {st.st_size} {st.st_mtime_ns}\n".encode())
+    hash_package(h)
+    for p in sorted(book.glob("*.ipynb")):
+        h.update(f"page {p.stem} {headings(p.stem, book)!r}\n".encode())
+    return h.hexdigest()
+
+
+def hash_package(h: hashlib._Hash) -> None:
+    """Feed ``h`` every file of the ``safepg`` package (its path and bytes): the code and the authors' data."""
     for p in sorted(PACKAGE.rglob("*")):
         if p.is_file() and "__pycache__" not in p.parts:
             h.update(f"code {p.relative_to(PACKAGE).as_posix()}\n".encode())
             h.update(p.read_bytes())
-    for p in sorted(book.glob("*.ipynb")):
-        h.update(f"page {p.stem} {headings(p.stem, book)!r}\n".encode())
-    return h.hexdigest()
 
 
 def _read(path: Path) -> list[Row] | None:
