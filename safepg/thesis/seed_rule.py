@@ -36,7 +36,7 @@ from safepg.thesis.experiment_store import (
 )
 from safepg.thesis.experiments import CURVE_SEEDS, EXPERIMENTS, get_experiment
 from safepg.thesis.scorecard.rules import Row
-from safepg.thesis.scorecard.stored import FOLDER, hash_package
+from safepg.thesis.scorecard.stored import FOLDER, hash_package, hash_run_files
 from safepg.thesis.scorecard.verdicts import RANDOM_KINDS, SEED_BLOCK
 
 #: The seeds a configuration starts with, by the kind of row it feeds (the most of its rows').
@@ -123,11 +123,7 @@ def rule_inputs_key(root: Path) -> str:
     """
     h = hashlib.sha256()
     for name in sorted(EXPERIMENTS):
-        folder = experiment_folder(name, root)
-        for p in sorted(folder.rglob("*")) if folder.is_dir() else ():
-            if p.is_file():
-                st = p.stat()
-                h.update(f"run {p.relative_to(root).as_posix()} {st.st_size} {st.st_mtime_ns}\n".encode())
+        hash_run_files(h, root, experiment_folder(name, root))
     campaign = root / CAMPAIGN_FILE
     h.update(b"campaign " + (campaign.read_bytes() if campaign.is_file() else b"none") + b"\n")
     hash_package(h)

@@ -32,16 +32,24 @@ def inputs_key(root: Path, book: Path) -> str:
     """SHA-256 (hex) of the scorecard's inputs: the run files under ``root``, the package's files
     and the headings of ``book``'s chapters."""
     h = hashlib.sha256()
-    if root.is_dir():
-        for p in sorted(root.rglob("*")):
-            rel = p.relative_to(root)
-            if rel.parts[0] != FOLDER and p.is_file():
-                st = p.stat()
-                h.update(f"run {rel.as_posix()} {st.st_size} {st.st_mtime_ns}\n".encode())
+    hash_run_files(h, root, root)
     hash_package(h)
     for p in sorted(book.glob("*.ipynb")):
         h.update(f"page {p.stem} {headings(p.stem, book)!r}\n".encode())
     return h.hexdigest()
+
+
+def hash_run_files(h: hashlib._Hash, root: Path, folder: Path) -> None:
+    """Feed ``h`` every file under ``folder`` (a folder of the results folder ``root``, or ``root`` itself)
+    by its path from ``root``, size and modification time (a run written again is another input); the
+    stored scorecard's own folder is not an input."""
+    if not folder.is_dir():
+        return
+    for p in sorted(folder.rglob("*")):
+        rel = p.relative_to(root)
+        if rel.parts[0] != FOLDER and p.is_file():
+            st = p.stat()
+            h.update(f"run {rel.as_posix()} {st.st_size} {st.st_mtime_ns}\n".encode())
 
 
 def hash_package(h: hashlib._Hash) -> None:
