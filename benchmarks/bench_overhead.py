@@ -39,9 +39,9 @@ import numpy as np
 from bench_step_floor import STABLE, _cartpole_bare, _normals, bare_step_shape, best_ns_per_step
 from machine import cpu
 
-from safepg import portable
 from safepg.envs import _cartpole_kernel, _lqg_fixed_step, _lqg_kernel
 from safepg.envs.cartpole import CartPole
+from safepg.thesis.budget import run_counts
 from safepg.thesis.experiments import get_experiment
 
 OUT = Path(__file__).with_name("overhead.json")
@@ -90,16 +90,6 @@ def kernels_timed(clock: Clock) -> Iterator[None]:
         _lqg_fixed_step.FIXED_STEP_BATCHES.update(fixed)
 
 
-def work(cfg: Any, rec: Any) -> tuple[int, int]:
-    """(steps, normals) of a run, as ``safepg.thesis.budget`` counts them."""
-    env = cfg.make_task()
-    n = int(rec.batch_size.sum())
-    if isinstance(env, CartPole):
-        lived = round(portable.dot(rec.batch_size.astype(float), rec.J_hat))
-        return lived, lived
-    return n * env.horizon, n * env.horizon * env.dim
-
-
 def measure(repeat: int) -> dict[str, Any]:
     numba.set_num_threads(1)
     key = np.uint64(12345)
@@ -120,11 +110,12 @@ def measure(repeat: int) -> dict[str, Any]:
                     t0 = time.perf_counter()
                     rec = cfg.run(0, theta0=theta0)
                     total = time.perf_counter() - t0
-                finals[f"{name}"] = rec.theta[-1]
-                steps, normals = work(cfg, rec)
-                floor = (steps * bare_ns if isinstance(cfg.make_task(), CartPole) else normals * normal_ns) / 1e9
+                finals[name] = rec.theta[-1]
+                env = cfg.make_task()
+                trajectories, steps, normals, _ = run_counts(env, rec)
+                floor = (steps * bare_ns if isinstance(env, CartPole) else normals * normal_ns) / 1e9
                 rows.append({"chapter": chapter, "experiment": name, "config": cfg.name,
-                             "trajectories": int(rec.batch_size.sum()), "iterations": int(rec.batch_size.size),
+                             "trajectories": trajectories, "iterations": int(rec.batch_size.size),
                              "mean_batch": float(rec.batch_size.mean()), "steps": steps, "normals": normals,
                              "seconds": round(total, 3), "kernel_s": round(clock.seconds, 3),
                              "floor_s": round(floor, 3), "ratio": round(total / floor, 2),

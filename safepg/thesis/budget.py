@@ -20,6 +20,7 @@ from typing import Any
 
 from safepg import portable
 from safepg.envs.cartpole import CartPole
+from safepg.record import LearningRecord
 from safepg.runner import RESULTS_VERSION
 from safepg.thesis.campaign import TIMING_FILE
 from safepg.thesis.chapters import CHAPTERS, chapter_experiments
@@ -83,23 +84,24 @@ def experiment_work(name: str, chapter: str, root: Path) -> Work:
     """
     exp = get_experiment(name)
     recs = load_experiment(exp, root)
-    traj = steps = normals = uniforms = 0
+    totals = [0, 0, 0, 0]
     for cfg in exp.configs:
         env = cfg.make_task()
         for rec in recs.get(cfg.name, []):
-            n = int(rec.batch_size.sum())
-            traj += n
-            if isinstance(env, CartPole):
-                # Each batch's mean episode length times its size, summed exactly (no BLAS).
-                lived = round(portable.dot(rec.batch_size.astype(float), rec.J_hat))
-                steps += lived
-                normals += lived
-                uniforms += 4 * n
-            else:
-                steps += n * env.horizon
-                normals += n * env.horizon * env.dim
-                uniforms += n * env.dim
+            totals = [a + b for a, b in zip(totals, run_counts(env, rec))]
+    traj, steps, normals, uniforms = totals
     return Work(name, chapter, traj, steps, normals, uniforms, _timing_seconds(experiment_folder(exp, root)))
+
+
+def run_counts(env: Any, rec: LearningRecord) -> tuple[int, int, int, int]:
+    """(trajectories, steps, normals, uniforms) of one run ``rec`` on task ``env``, as
+    :func:`experiment_work` counts them."""
+    n = int(rec.batch_size.sum())
+    if isinstance(env, CartPole):
+        # Each batch's mean episode length times its size, summed exactly (no BLAS).
+        lived = round(portable.dot(rec.batch_size.astype(float), rec.J_hat))
+        return n, lived, lived, 4 * n
+    return n, n * env.horizon, n * env.horizon * env.dim, n * env.dim
 
 
 def sweep_work(root: Path) -> Work | None:
